@@ -1,0 +1,88 @@
+// Marazzato, Ern, Mariotti & Monasse's explicit scheme: BDZ (22) = [M 6], forces integrated
+// over the free flight by a symmetric quadrature.
+#pragma once
+
+#include "schemes/hamiltonian.h"
+#include "schemes/quadrature.h"
+#include "schemes/step_parameters.h"
+
+#include <utility>
+
+namespace hamiltone {
+
+// State at level n: q^n, p^{n−½}, p^{n+½}; reports t = n k, q^n and the pseudo-energy (13)
+//   H̃^n = V(q^n) + ½ (p^{n−½})ᵀ M⁻¹ p^{n+½}
+// (kinetic = the second term, which has no sign), and the discrete energy (17) on request.
+// Started by [M 7]: p^{−½} = p^{½} = p(0), so H̃^0 = H(0) exactly. Lossless, as in the paper.
+template <HamiltonianSystem S>
+class Marazzato {
+ public:
+  Marazzato(S system, const StepParameters& params, const InitialState& start, QuadratureRule rule)
+      : system_(std::move(system)), params_(params), quadrature_(quadrature(rule)) {
+    checkStepParameters(params_, /*hasEpsilon=*/false);
+    if (params_.sigma0 != 0.0)
+      throw std::invalid_argument("loss sigma0 = " + formatNumber(params_.sigma0) +
+                                  ": Marazzato's scheme is lossless here; use sigma0 = 0");
+    const Eigen::Index n = system_.size();
+    checkInitialState(start, n);
+    for (Vector* v : {&q_, &qNext_, &pPrev_, &p_, &pNext_, &x_, &grad_, &force_, &kq_})
+      v->setZero(n);
+    q_ = start.q;
+    pPrev_ = start.p;  // [M 7]
+    p_ = start.p;
+  }
+
+  // (22) / [M 6]: q^{n+1} = q^n + k M⁻¹ p^{n+½};  p^{n+3/2} = p^{n−½} − 2 Q_n(∇V(q̂^n(t)))
+  // with the free flight q̂^n(t) = q^n + (t − t^n) M⁻¹ p^{n+½}, sampled at the nodes [M 9].
+  void step() noexcept {
+    const double k = params_.k;
+    qNext_ = q_ + k * system_.inverseMass().cwiseProduct(p_);
+    force_.setZero();
+    for (int i = 0; i < quadrature_.count; ++i) {
+      const double theta = quadrature_.node[i];
+      x_ = (1.0 - theta) * q_ + theta * qNext_;
+      fullGradient(system_, x_, grad_, kq_);
+      force_ += (k * quadrature_.weight[i]) * grad_;
+    }
+    pNext_ = pPrev_ - 2.0 * force_;
+    // rotate: p^{n−½} ← p^{n+½} ← p^{n+3/2},  q^n ← q^{n+1}
+    pPrev_.swap(p_);
+    p_.swap(pNext_);
+    q_.swap(qNext_);
+    ++n_;
+  }
+
+  // Pseudo-energy (13): potential V(q^n), "kinetic" ½ (p^{n−½})ᵀ M⁻¹ p^{n+½}.
+  Energy energy() const {
+    Energy e;
+    e.potential = fullPotential(system_, q_, kq_);
+    e.kinetic = 0.5 * pPrev_.dot(system_.inverseMass().cwiseProduct(p_));
+    return e;
+  }
+
+  // Discrete energy (17): V(q^n) + ⅛ (p^{n−½} + p^{n+½})ᵀ M⁻¹ (p^{n−½} + p^{n+½}) >= H̃^n, (18).
+  double discreteEnergy() const {
+    return fullPotential(system_, q_, kq_) +
+           0.125 * ((pPrev_ + p_).array().square() * system_.inverseMass().array()).sum();
+  }
+
+  long stepIndex() const { return n_; }
+  double time() const { return static_cast<double>(n_) * params_.k; }
+  const Vector& q() const { return q_; }
+  const Vector& p() const { return p_; }  // p^{n+½}
+  double dissipated() const { return 0.0; }
+  const S& system() const { return system_; }
+  const StepParameters& parameters() const { return params_; }
+  const Quadrature& rule() const { return quadrature_; }
+
+ private:
+  S system_;
+  StepParameters params_;
+  Quadrature quadrature_;
+  Vector q_, qNext_, pPrev_, p_, pNext_;  // q^n, q^{n+1}, p^{n−½}, p^{n+½}, p^{n+3/2}
+  Vector x_, grad_, force_;                // a node on the free flight, ∇V there, Q_n
+  mutable Vector kq_;                      // K q, scratch of the potential evaluations
+  long n_ = 0;
+};
+
+}  // namespace hamiltone

@@ -1,0 +1,56 @@
+// The numbers every time-stepping scheme takes, their validation, and the centred loss they share.
+#pragma once
+
+#include "schemes/hamiltonian.h"
+#include "util/format_number.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace hamiltone {
+
+struct StepParameters {
+  double k = 0.0;        // time step, s
+  double sigma0 = 0.0;   // mass-proportional loss: force −2σ0 M q', 1/s   (6), (49)
+  double epsilon = 0.0;  // gauge shift of the quadratised potential, §2.5 (SAV schemes only)
+};
+
+// Throws std::invalid_argument naming the parameter, its value and what is valid.
+inline void checkStepParameters(const StepParameters& p, bool hasEpsilon) {
+  if (!std::isfinite(p.k) || p.k <= 0.0)
+    throw std::invalid_argument("time step k = " + formatNumber(p.k) +
+                                ": must be a finite number > 0 (seconds)");
+  if (!std::isfinite(p.sigma0) || p.sigma0 < 0.0)
+    throw std::invalid_argument("loss sigma0 = " + formatNumber(p.sigma0) +
+                                ": must be a finite number >= 0 (1/s)");
+  if (p.sigma0 * p.k >= 1.0)
+    throw std::invalid_argument("loss sigma0 = " + formatNumber(p.sigma0) + " with k = " +
+                                formatNumber(p.k) + ": sigma0*k must be < 1, i.e. sigma0 < " +
+                                formatNumber(1.0 / p.k));
+  if (!hasEpsilon && p.epsilon != 0.0)
+    throw std::invalid_argument("gauge shift epsilon = " + formatNumber(p.epsilon) +
+                                ": only the SAV schemes (27), (38) take a gauge shift");
+  if (!std::isfinite(p.epsilon) || p.epsilon < 0.0)
+    throw std::invalid_argument("gauge shift epsilon = " + formatNumber(p.epsilon) +
+                                ": must be a finite number >= 0 (J)");
+}
+
+inline void checkInitialState(const InitialState& s, Eigen::Index n) {
+  if (s.q.size() != n || s.p.size() != n)
+    throw std::invalid_argument("initial state has " + std::to_string(s.q.size()) + " positions and " +
+                                std::to_string(s.p.size()) + " momenta; the system has " +
+                                std::to_string(n) + " coordinates");
+  if (!s.q.allFinite() || !s.p.allFinite())
+    throw std::invalid_argument("initial state is not finite");
+}
+
+// σ0/(2k) ‖q^{n+1} − q^{n−1}‖²_M: the energy the centred loss takes in one step,
+// from the balance (50) with M R = 2σ0 I and p^{n+½} + p^{n−½} = M (q^{n+1} − q^{n−1}) / k.
+inline double centredLossDissipation(const StepParameters& p, const Vector& inverseMass,
+                                     const Vector& qNext, const Vector& qPrev) noexcept {
+  if (p.sigma0 == 0.0) return 0.0;
+  return p.sigma0 / (2.0 * p.k) * ((qNext - qPrev).array().square() / inverseMass.array()).sum();
+}
+
+}  // namespace hamiltone

@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Installs the Debian packages Hamiltone builds with — only those missing, so a second run is instant.
+# Works as root, or through sudo otherwise; never prompts (CI has no terminal).
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build pkg-config
+  libeigen3-dev       # engine: vectors and the scheme state
+  libcli11-dev        # render/: hamiltone-sim's command line
+  libgtest-dev libgmock-dev  # tests/
+  libbenchmark-dev    # bench/
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+
+if [ "$(id -u)" -eq 0 ]; then
+  as_root=()
+elif command -v sudo >/dev/null 2>&1; then
+  as_root=(sudo)
+else
+  echo "install-deps: need root or sudo to install: ${missing[*]}" >&2
+  exit 1
+fi
+
+echo "install-deps: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+"${as_root[@]}" apt-get update -qq
+"${as_root[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null

@@ -1,0 +1,94 @@
+// Second-order convergence of every scheme on FPU, BDZ Fig. 3: the L² error (55) over 1 s against
+// Störmer–Verlet at k = 2⁻¹⁸, for k = 2⁻⁸ … 2⁻¹¹, α = 10.
+#include "support/fpu_runs.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace hamiltone {
+namespace {
+
+using testing::paperChain;
+using testing::stepsFor;
+
+constexpr double kAlpha = 10.0;
+constexpr int kReferenceLog2 = 18;
+
+const std::vector<Vector>& reference() {
+  static const std::vector<Vector> ref = [] {
+    const FermiPastaUlam chain = paperChain();
+    const double k = std::ldexp(1.0, -kReferenceLog2);
+    StormerVerlet<FermiPastaUlam> sv(chain, {.k = k}, fpuInitialState(chain, kAlpha));
+    return testing::trajectory(sv, stepsFor(1.0, k));
+  }();
+  return ref;
+}
+
+// (55): sqrt(Σ_n k ‖q^n − q_ref(n k)‖²). k = 2^−log2k, so q_ref(n k) is reference step n·2^(18−log2k).
+double error55(const std::vector<Vector>& q, int log2k) {
+  const double k = std::ldexp(1.0, -log2k);
+  const long stride = 1L << (kReferenceLog2 - log2k);
+  double sum = 0.0;
+  for (size_t n = 0; n < q.size(); ++n) sum += k * (q[n] - reference()[n * stride]).squaredNorm();
+  return std::sqrt(sum);
+}
+
+// Least-squares slope of log(error) against log(k).
+template <class MakeScheme>
+double convergenceOrder(MakeScheme make) {
+  std::vector<double> x, y;
+  for (int log2k = 8; log2k <= 11; ++log2k) {
+    const double k = std::ldexp(1.0, -log2k);
+    auto scheme = make(k);
+    const double e = error55(testing::trajectory(scheme, stepsFor(1.0, k)), log2k);
+    x.push_back(std::log(k));
+    y.push_back(std::log(e));
+  }
+  const double n = static_cast<double>(x.size());
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  for (size_t i = 0; i < x.size(); ++i) {
+    sx += x[i];
+    sy += y[i];
+    sxx += x[i] * x[i];
+    sxy += x[i] * y[i];
+  }
+  return (n * sxy - sx * sy) / (n * sxx - sx * sx);
+}
+
+const InitialState& start() {
+  static const InitialState s = fpuInitialState(paperChain(), kAlpha);
+  return s;
+}
+
+TEST(Convergence, StormerVerletIsSecondOrder) {
+  const double order = convergenceOrder(
+      [](double k) { return StormerVerlet<FermiPastaUlam>(paperChain(), {.k = k}, start()); });
+  EXPECT_GE(order, 1.8);
+  EXPECT_LE(order, 2.2);
+}
+
+TEST(Convergence, MarazzatoMidpointIsSecondOrder) {
+  const double order = convergenceOrder([](double k) {
+    return Marazzato<FermiPastaUlam>(paperChain(), {.k = k}, start(), QuadratureRule::midpoint);
+  });
+  EXPECT_GE(order, 1.8);
+  EXPECT_LE(order, 2.2);
+}
+
+TEST(Convergence, NonSplitSavIsSecondOrder) {
+  const double order = convergenceOrder(
+      [](double k) { return NonSplitSav<FermiPastaUlam>(paperChain(), {.k = k}, start()); });
+  EXPECT_GE(order, 1.8);
+  EXPECT_LE(order, 2.2);
+}
+
+TEST(Convergence, SplitSavIsSecondOrder) {
+  const double order = convergenceOrder(
+      [](double k) { return SplitSav<FermiPastaUlam>(paperChain(), {.k = k}, start()); });
+  EXPECT_GE(order, 1.8);
+  EXPECT_LE(order, 2.2);
+}
+
+}  // namespace
+}  // namespace hamiltone
