@@ -1,16 +1,15 @@
-// Numbers in error messages, printed so the user sees the value exactly as it was taken.
+// Numbers in error messages: the shortest text that reads back as the same double.
 #pragma once
 
-#include <sstream>
+#include <charconv>
 #include <string>
 
 namespace hamiltone {
 
 inline std::string formatNumber(double x) {
-  std::ostringstream s;
-  s.precision(17);
-  s << x;
-  return s.str();
+  char buffer[32];
+  const auto end = std::to_chars(buffer, buffer + sizeof buffer, x).ptr;
+  return std::string(buffer, end);
 }
 
 }  // namespace hamiltone

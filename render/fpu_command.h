@@ -1,0 +1,25 @@
+// `hamiltone-sim fpu`: the Fermi–Pasta–Ulam test problem of BDZ §4.1 with any scheme of the engine.
+#pragma once
+
+#include <CLI/App.hpp>
+
+#include <string>
+
+namespace hamiltone::cli {
+
+// The command line as typed; numbers are parsed and checked by run().
+struct FpuArguments {
+  std::string scheme;
+  std::string quadrature;
+  std::string k = "1e-3", duration = "1", alpha = "1", omega = "50", pairs = "3";
+  std::string epsilon = "0", sigma0 = "0", every = "1";
+  std::string out;
+};
+
+// Registers the subcommand and its options on `app`; the returned pointer tells if it was chosen.
+CLI::App* addFpuCommand(CLI::App& app, FpuArguments& args);
+
+// Validates, simulates, writes the CSV and prints a summary. Throws UsageError on bad input.
+int runFpuCommand(const FpuArguments& args);
+
+}  // namespace hamiltone::cli

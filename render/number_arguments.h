@@ -1,0 +1,16 @@
+// Numbers from the command line, parsed strictly: the whole text, finite, in range — else UsageError.
+#pragma once
+
+#include <string>
+
+namespace hamiltone::cli {
+
+enum class Range { any, positive, nonNegative };
+
+// `flag` = "--k" names the argument in the message; `unit` is appended to what is valid.
+double parseReal(const std::string& flag, const std::string& text, Range range,
+                 const std::string& unit = "");
+// A whole number >= `minimum`.
+long parseInteger(const std::string& flag, const std::string& text, long minimum);
+
+}  // namespace hamiltone::cli

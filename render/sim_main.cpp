@@ -1,0 +1,42 @@
+// hamiltone-sim: the papers' test problems from the command line, one subcommand each.
+#include "fpu_command.h"
+#include "usage_error.h"
+
+#include <CLI/App.hpp>
+#include <CLI/Config.hpp>
+#include <CLI/Formatter.hpp>
+
+#include <cstdio>
+#include <exception>
+
+int main(int argc, char** argv) {
+  using namespace hamiltone::cli;
+  CLI::App app{"hamiltone-sim: runs the test problems of Bilbao, Ducceschi & Zama (2022) and "
+               "Marazzato et al. (2020) on Hamiltone's schemes and writes CSV."};
+  app.require_subcommand(1);
+  FpuArguments fpu;
+  CLI::App* fpuCommand = addFpuCommand(app, fpu);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "hamiltone-sim: %s (see hamiltone-sim --help)\n", e.what());
+    return kExitUsage;
+  }
+
+  try {
+    if (fpuCommand->parsed()) return runFpuCommand(fpu);
+  } catch (const UsageError& e) {
+    std::fprintf(stderr, "hamiltone-sim %s: %s\n", app.get_subcommands().front()->get_name().c_str(),
+                 e.what());
+    return kExitUsage;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "hamiltone-sim: error: %s\n", e.what());
+    return 1;
+  }
+  return kExitUsage;
+}

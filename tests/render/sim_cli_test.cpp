@@ -1,0 +1,165 @@
+// hamiltone-sim fpu as a user meets it: the CSV it writes, and every bad input refused with
+// exit code 2, one line naming the argument, and no output file.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Result {
+  int exitCode;
+  std::string out, err;
+};
+
+class SimCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("hamiltone-cli-" + std::to_string(::getpid()) + "-" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  Result run(const std::string& args) {
+    const std::string cmd = std::string(HAMILTONE_SIM) + " " + args + " >" +
+                            (dir_ / "stdout").string() + " 2>" + (dir_ / "stderr").string() +
+                            " </dev/null";
+    const int status = std::system(cmd.c_str());
+    Result r{WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(dir_ / "stdout"),
+             slurp(dir_ / "stderr")};
+    fs::remove(dir_ / "stdout");
+    fs::remove(dir_ / "stderr");
+    return r;
+  }
+
+  static std::string slurp(const fs::path& p) {
+    std::ifstream in(p);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  }
+
+  std::string csv() const { return (dir_ / "run.csv").string(); }
+
+  // Exit 2, a single line on stderr that mentions `mention`, nothing on stdout, no file left.
+  void expectRefused(const std::string& args, const std::string& mention) {
+    const Result r = run(args);
+    EXPECT_EQ(r.exitCode, 2) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find(mention), std::string::npos) << args << "\nstderr: " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+    EXPECT_TRUE(fs::is_empty(dir_)) << args << ": left a file behind";
+  }
+
+  fs::path dir_;
+};
+
+std::vector<std::vector<double>> parseRows(const std::string& text, std::string& header) {
+  std::istringstream in(text);
+  std::getline(in, header);
+  std::vector<std::vector<double>> rows;
+  for (std::string line; std::getline(in, line);) {
+    std::vector<double> row;
+    std::istringstream cells(line);
+    for (std::string cell; std::getline(cells, cell, ',');) row.push_back(std::stod(cell));
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+TEST_F(SimCli, WritesTheDocumentedCsv) {
+  const Result r = run("fpu --scheme sav-split --k 1e-3 --duration 0.01 --alpha 10 --every 3 --out " +
+                       csv());
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.out.find("max relative energy drift (51)"), std::string::npos) << r.out;
+  std::string header;
+  const auto rows = parseRows(slurp(csv()), header);
+  EXPECT_EQ(header, "t,q1,q2,q3,q4,q5,q6,energy,kinetic,potential");
+  // Steps 0, 3, 6, 9 of 10.
+  ASSERT_EQ(rows.size(), 4u);
+  for (size_t i = 0; i < rows.size(); ++i) {
+    ASSERT_EQ(rows[i].size(), 10u);
+    EXPECT_NEAR(rows[i][0], 3e-3 * static_cast<double>(i), 1e-15);
+    EXPECT_NEAR(rows[i][7], rows[0][7], 1e-12 * rows[0][7]);  // (41) conserved
+    EXPECT_NEAR(rows[i][7], rows[i][8] + rows[i][9], 1e-12 * rows[0][7]);
+  }
+  EXPECT_EQ(rows[0][4], 10.0);  // q(0) = α e₄, printed exactly
+  EXPECT_TRUE(fs::is_regular_file(csv()));
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1);
+}
+
+TEST_F(SimCli, EverySchemeRunsAndDivergenceIsReported) {
+  for (const std::string scheme : {"sv", "sav", "sav-split", "marazzato --quadrature gl5"}) {
+    const Result r = run("fpu --scheme " + scheme + " --duration 0.05 --out " + csv());
+    EXPECT_EQ(r.exitCode, 0) << scheme << ": " << r.err;
+    EXPECT_TRUE(r.err.empty()) << r.err;
+  }
+  // Störmer–Verlet at α = 100, k = 0.02 blows up; the run stops with a warning, the file is whole.
+  const Result r = run("fpu --scheme sv --alpha 100 --k 0.02 --duration 10 --out " + csv());
+  EXPECT_EQ(r.exitCode, 0);
+  EXPECT_NE(r.err.find("non-finite"), std::string::npos) << r.err;
+  std::string header;
+  const auto rows = parseRows(slurp(csv()), header);
+  ASSERT_FALSE(rows.empty());
+  EXPECT_LT(rows.size(), 500u);
+  EXPECT_FALSE(std::isfinite(rows.back()[7]) && std::isfinite(rows.back()[4]));
+}
+
+TEST_F(SimCli, HelpDocumentsTheOptions) {
+  const Result r = run("fpu --help");
+  EXPECT_EQ(r.exitCode, 0);
+  for (const char* flag : {"--scheme", "--quadrature", "--k", "--duration", "--alpha", "--omega",
+                           "--pairs", "--epsilon", "--sigma0", "--every", "--out", "H^{n+1/2}"})
+    EXPECT_NE(r.out.find(flag), std::string::npos) << flag;
+}
+
+TEST_F(SimCli, RefusesBadInput) {
+  const std::string ok = "fpu --scheme sav --out " + csv();
+  expectRefused(ok + " --bogus 1", "--bogus");
+  expectRefused(ok + " --k abc", "--k");
+  expectRefused(ok + " --k 1e-3x", "--k");
+  expectRefused(ok + " --k nan", "--k");
+  expectRefused(ok + " --k inf", "--k");
+  expectRefused(ok + " --k 0", "--k");
+  expectRefused(ok + " --k -1e-3", "--k");
+  expectRefused(ok + " --duration 0", "--duration");
+  expectRefused(ok + " --omega -50", "--omega");
+  expectRefused(ok + " --pairs 1", "--pairs");
+  expectRefused(ok + " --pairs 2.5", "--pairs");
+  expectRefused(ok + " --every 0", "--every");
+  expectRefused(ok + " --sigma0 -1", "--sigma0");
+  expectRefused(ok + " --quadrature gl2", "--quadrature");
+  expectRefused("fpu --scheme rk4 --out " + csv(), "--scheme");
+  expectRefused("fpu --scheme marazzato --quadrature simpson --out " + csv(), "--quadrature");
+  expectRefused("fpu --scheme marazzato --sigma0 1 --out " + csv(), "--sigma0");
+  expectRefused("fpu --scheme sv --epsilon 1 --out " + csv(), "--epsilon");
+  expectRefused("fpu --scheme sav-split --k 0.05 --out " + csv(), "(44)");
+  expectRefused("fpu --scheme sav", "--out");
+  expectRefused("", "subcommand");
+}
+
+TEST_F(SimCli, RefusesAnUnwritableOutput) {
+  expectRefused("fpu --scheme sav --out " + (dir_ / "missing-dir" / "run.csv").string(), "--out");
+  expectRefused("fpu --scheme sav --out " + dir_.string(), "--out");
+}
+
+TEST_F(SimCli, LeavesAnExistingFileAloneOnError) {
+  { std::ofstream(csv()) << "keep\n"; }
+  const Result r = run("fpu --scheme sav --k zero --out " + csv());
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_EQ(slurp(csv()), "keep\n");
+}
+
+}  // namespace
