@@ -1,8 +1,6 @@
 // mkstemp in the target's directory, so the final rename(2) is atomic on the same file system.
 #include "atomic_file.h"
 
-#include "usage_error.h"
-
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -10,6 +8,8 @@
 #include <cstring>
 #include <stdexcept>
 #include <vector>
+
+#include "usage_error.h"
 
 namespace hamiltone::cli {
 

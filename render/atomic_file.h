@@ -1,4 +1,4 @@
-// An output file that appears whole or not at all: written to a temporary beside it, renamed on commit.
+// An output file that appears whole or not at all: a temporary beside it, renamed on commit.
 #pragma once
 
 #include <cstdio>

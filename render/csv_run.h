@@ -1,12 +1,12 @@
 // Steps a scheme and writes its rows as CSV: `t, <state columns>, energy, kinetic, potential`.
 #pragma once
 
-#include "schemes/hamiltonian.h"
-
 #include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
+
+#include "schemes/hamiltonian.h"
 
 namespace hamiltone::cli {
 

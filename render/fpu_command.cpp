@@ -1,6 +1,11 @@
 // Parses the fpu subcommand, builds the chosen scheme over the FPU chain and writes its CSV.
 #include "fpu_command.h"
 
+#include <CLI/Validators.hpp>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
 #include "atomic_file.h"
 #include "csv_run.h"
 #include "models/fpu.h"
@@ -9,12 +14,6 @@
 #include "schemes/sav.h"
 #include "schemes/stormer_verlet.h"
 #include "usage_error.h"
-
-#include <CLI/Validators.hpp>
-
-#include <cmath>
-#include <cstdio>
-#include <stdexcept>
 
 namespace hamiltone::cli {
 
@@ -73,7 +72,8 @@ struct FpuRun {
 template <class Scheme>
 RunSummary simulate(Scheme scheme, const FpuRun& run, std::FILE* out) {
   std::fprintf(out, "t");
-  for (Eigen::Index i = 1; i <= run.chain.size(); ++i) std::fprintf(out, ",q%ld", static_cast<long>(i));
+  for (Eigen::Index i = 1; i <= run.chain.size(); ++i)
+    std::fprintf(out, ",q%ld", static_cast<long>(i));
   std::fprintf(out, ",energy,kinetic,potential\n");
   return runToCsv(scheme, run.steps, run.every, out, [](const Scheme& s, std::FILE* f) {
     for (double x : s.q()) writeNumber(f, x);
@@ -104,9 +104,11 @@ int runFpuCommand(const FpuArguments& a) {
   if (!a.quadrature.empty() && a.scheme != "marazzato")
     throw UsageError("--quadrature = " + a.quadrature + ": applies to --scheme marazzato only");
   if (epsilon != 0.0 && (a.scheme == "sv" || a.scheme == "marazzato"))
-    throw UsageError("--epsilon = " + a.epsilon + ": the gauge shift applies to --scheme sav or sav-split only");
+    throw UsageError("--epsilon = " + a.epsilon +
+                     ": the gauge shift applies to --scheme sav or sav-split only");
   if (sigma0 != 0.0 && a.scheme == "marazzato")
-    throw UsageError("--sigma0 = " + a.sigma0 + ": marazzato is lossless; use sv, sav or sav-split");
+    throw UsageError("--sigma0 = " + a.sigma0 +
+                     ": marazzato is lossless; use sv, sav or sav-split");
   const double stepsReal = std::floor(duration / k * (1.0 + 1e-12));
   if (stepsReal < 1.0 || stepsReal > 1e10)
     throw UsageError("--duration / --k = " + std::to_string(duration / k) +
@@ -114,25 +116,30 @@ int runFpuCommand(const FpuArguments& a) {
   if (pairs > 1'000'000) throw UsageError("--pairs = " + a.pairs + ": expected at most 1000000");
 
   FpuRun run{building([&] { return FermiPastaUlam(static_cast<int>(pairs), omega); }),
-             {}, {.k = k, .sigma0 = sigma0, .epsilon = epsilon}, static_cast<long>(stepsReal), every};
+             {},
+             {.k = k, .sigma0 = sigma0, .epsilon = epsilon},
+             static_cast<long>(stepsReal),
+             every};
   run.start = building([&] { return fpuInitialState(run.chain, alpha); });
 
   AtomicFile file(a.out, "--out");
   RunSummary summary;
   if (a.scheme == "sv") {
-    summary = simulate(building([&] { return StormerVerlet(run.chain, run.params, run.start); }), run,
-                       file.stream());
+    summary = simulate(building([&] { return StormerVerlet(run.chain, run.params, run.start); }),
+                       run, file.stream());
   } else if (a.scheme == "sav") {
-    summary = simulate(building([&] { return NonSplitSav<FermiPastaUlam>(run.chain, run.params, run.start); }),
-                       run, file.stream());
+    summary = simulate(
+        building([&] { return NonSplitSav<FermiPastaUlam>(run.chain, run.params, run.start); }),
+        run, file.stream());
   } else if (a.scheme == "sav-split") {
-    summary = simulate(building([&] { return SplitSav<FermiPastaUlam>(run.chain, run.params, run.start); }),
-                       run, file.stream());
+    summary = simulate(
+        building([&] { return SplitSav<FermiPastaUlam>(run.chain, run.params, run.start); }), run,
+        file.stream());
   } else {
     const QuadratureRule rule =
         a.quadrature.empty() ? QuadratureRule::midpoint : *parseQuadratureRule(a.quadrature);
-    summary = simulate(building([&] { return Marazzato(run.chain, run.params, run.start, rule); }), run,
-                       file.stream());
+    summary = simulate(building([&] { return Marazzato(run.chain, run.params, run.start, rule); }),
+                       run, file.stream());
   }
   file.commit();
 

@@ -1,11 +1,11 @@
 // Strict number parsing for hamiltone-sim: "1e-3" yes; "1e-3x", "", "nan", "inf" no.
 #include "number_arguments.h"
 
-#include "usage_error.h"
-
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+
+#include "usage_error.h"
 
 namespace hamiltone::cli {
 

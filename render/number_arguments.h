@@ -1,4 +1,4 @@
-// Numbers from the command line, parsed strictly: the whole text, finite, in range — else UsageError.
+// Command-line numbers, parsed strictly: the whole text, finite, in range, else UsageError.
 #pragma once
 
 #include <string>

@@ -1,18 +1,18 @@
 // hamiltone-sim: the papers' test problems from the command line, one subcommand each.
-#include "fpu_command.h"
-#include "usage_error.h"
-
 #include <CLI/App.hpp>
 #include <CLI/Config.hpp>
 #include <CLI/Formatter.hpp>
-
 #include <cstdio>
 #include <exception>
 
+#include "fpu_command.h"
+#include "usage_error.h"
+
 int main(int argc, char** argv) {
   using namespace hamiltone::cli;
-  CLI::App app{"hamiltone-sim: runs the test problems of Bilbao, Ducceschi & Zama (2022) and "
-               "Marazzato et al. (2020) on Hamiltone's schemes and writes CSV."};
+  CLI::App app{
+      "hamiltone-sim: runs the test problems of Bilbao, Ducceschi & Zama (2022) and "
+      "Marazzato et al. (2020) on Hamiltone's schemes and writes CSV."};
   app.require_subcommand(1);
   FpuArguments fpu;
   CLI::App* fpuCommand = addFpuCommand(app, fpu);
@@ -31,8 +31,8 @@ int main(int argc, char** argv) {
   try {
     if (fpuCommand->parsed()) return runFpuCommand(fpu);
   } catch (const UsageError& e) {
-    std::fprintf(stderr, "hamiltone-sim %s: %s\n", app.get_subcommands().front()->get_name().c_str(),
-                 e.what());
+    std::fprintf(stderr, "hamiltone-sim %s: %s\n",
+                 app.get_subcommands().front()->get_name().c_str(), e.what());
     return kExitUsage;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "hamiltone-sim: error: %s\n", e.what());

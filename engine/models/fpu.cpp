@@ -1,11 +1,11 @@
 // The FPU chain's split potential (53) and its gradient, on 0-based storage x[j] = q_{j+1}.
 #include "models/fpu.h"
 
-#include "util/format_number.h"
-
 #include <cmath>
 #include <stdexcept>
 #include <string>
+
+#include "util/format_number.h"
 
 namespace hamiltone {
 
@@ -65,8 +65,9 @@ double FermiPastaUlam::potential(const Vector& q) const {
 
 InitialState fpuInitialState(const FermiPastaUlam& chain, double alpha) {
   if (chain.size() < 4)
-    throw std::invalid_argument("pairs = " + std::to_string(chain.pairs()) +
-                                ": the initial condition displaces coordinate 4, so pairs must be >= 2");
+    throw std::invalid_argument(
+        "pairs = " + std::to_string(chain.pairs()) +
+        ": the initial condition displaces coordinate 4, so pairs must be >= 2");
   if (!std::isfinite(alpha))
     throw std::invalid_argument("alpha = " + formatNumber(alpha) + ": must be a finite number");
   InitialState s{Vector::Zero(chain.size()), Vector::Zero(chain.size())};

@@ -2,7 +2,6 @@
 #pragma once
 
 #include <Eigen/Core>
-
 #include <concepts>
 
 namespace hamiltone {
@@ -17,7 +16,7 @@ concept HamiltonianSystem = requires(const S& s, const Vector& q, Vector& out) {
   { S::hasStiffness } -> std::convertible_to<bool>;
   { s.size() } -> std::convertible_to<Eigen::Index>;
   { s.inverseMass() } -> std::convertible_to<const Vector&>;      // diagonal of M⁻¹
-  s.applyStiffness(q, out);                                         // out = K q
+  s.applyStiffness(q, out);                                       // out = K q
   { s.stiffnessEigenvalueMax() } -> std::convertible_to<double>;  // λmax(M^-½ K M^-½), for (44)
   { s.splitPotential(q) } -> std::convertible_to<double>;         // V'(q)
   { s.splitGradient(q, out) } -> std::convertible_to<double>;     // out = ∇V'(q); returns V'(q)

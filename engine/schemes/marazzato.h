@@ -2,11 +2,11 @@
 // over the free flight by a symmetric quadrature.
 #pragma once
 
+#include <utility>
+
 #include "schemes/hamiltonian.h"
 #include "schemes/quadrature.h"
 #include "schemes/step_parameters.h"
-
-#include <utility>
 
 namespace hamiltone {
 
@@ -80,8 +80,8 @@ class Marazzato {
   StepParameters params_;
   Quadrature quadrature_;
   Vector q_, qNext_, pPrev_, p_, pNext_;  // q^n, q^{n+1}, p^{n−½}, p^{n+½}, p^{n+3/2}
-  Vector x_, grad_, force_;                // a node on the free flight, ∇V there, Q_n
-  mutable Vector kq_;                      // K q, scratch of the potential evaluations
+  Vector x_, grad_, force_;               // a node on the free flight, ∇V there, Q_n
+  mutable Vector kq_;                     // K q, scratch of the potential evaluations
   long n_ = 0;
 };
 

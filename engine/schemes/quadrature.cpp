@@ -52,9 +52,9 @@ Quadrature quadrature(QuadratureRule rule) {
 
 namespace {
 constexpr std::pair<QuadratureRule, std::string_view> kNames[] = {
-    {QuadratureRule::midpoint, "midpoint"}, {QuadratureRule::gaussLegendre2, "gl2"},
+    {QuadratureRule::midpoint, "midpoint"},  {QuadratureRule::gaussLegendre2, "gl2"},
     {QuadratureRule::gaussLegendre3, "gl3"}, {QuadratureRule::gaussLegendre5, "gl5"},
-    {QuadratureRule::lobatto3, "lobatto3"}, {QuadratureRule::lobatto5, "lobatto5"}};
+    {QuadratureRule::lobatto3, "lobatto3"},  {QuadratureRule::lobatto5, "lobatto5"}};
 }
 
 std::optional<QuadratureRule> parseQuadratureRule(std::string_view text) {

@@ -1,4 +1,4 @@
-// Symmetric quadratures on [0, 1] for the force integral of Marazzato et al.'s scheme, [M 8]–[M 11].
+// Symmetric quadratures on [0, 1] for Marazzato et al.'s force integral, [M 8]–[M 11].
 #pragma once
 
 #include <array>
@@ -7,7 +7,14 @@
 
 namespace hamiltone {
 
-enum class QuadratureRule { midpoint, gaussLegendre2, gaussLegendre3, gaussLegendre5, lobatto3, lobatto5 };
+enum class QuadratureRule {
+  midpoint,
+  gaussLegendre2,
+  gaussLegendre3,
+  gaussLegendre5,
+  lobatto3,
+  lobatto5
+};
 
 // ∫₀¹ f(θ) dθ ≈ Σ weight[i] f(node[i]); symmetric in the sense of [M 11].
 struct Quadrature {

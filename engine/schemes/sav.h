@@ -1,11 +1,11 @@
-// The explicit exactly energy-conserving SAV schemes of BDZ: non-split (27) and split-potential (38).
+// BDZ's explicit exactly energy-conserving SAV schemes: non-split (27), split-potential (38).
 #pragma once
-
-#include "schemes/hamiltonian.h"
-#include "schemes/step_parameters.h"
 
 #include <cmath>
 #include <utility>
+
+#include "schemes/hamiltonian.h"
+#include "schemes/step_parameters.h"
 
 namespace hamiltone {
 
@@ -69,8 +69,8 @@ class SavScheme {
       gqm += gv[i] * qm[i];
       gMg += gv[i] * minv[i] * gv[i];
     }
-    const double btqm = h * gqm;      // βᵀ q^{n−1}
-    const double bta = h * h * gMg;   // βᵀ α
+    const double btqm = h * gqm;     // βᵀ q^{n−1}
+    const double bta = h * h * gMg;  // βᵀ α
     const double kk = k * k;
     const double twoKPsi = 2.0 * k * psi_;
 
@@ -96,7 +96,7 @@ class SavScheme {
       gdq += gv[i] * d;
       lost += d * d * mass[i];
     }
-    psi_ += 0.5 * s * gdq;  // (38c)
+    psi_ += 0.5 * s * gdq;                             // (38c)
     dissipated_ += params_.sigma0 / (2.0 * k) * lost;  // (50)
 
     prev_.swap(curr_);
@@ -104,7 +104,8 @@ class SavScheme {
     ++n_;
   }
 
-  // (41) [(36) when nonSplit], at level n: kinetic ½(δq)ᵀM(δq)/k², potential ½ q^{n+1}ᵀK q^n + ½ψ² − ε.
+  // (41) [(36) when nonSplit], at level n: kinetic ½(δq)ᵀM(δq)/k², potential ½ q^{n+1}ᵀK q^n + ½ψ²
+  // − ε.
   Energy energy() const {
     Energy e;
     e.kinetic = intervalKineticEnergy(system_.inverseMass(), prev_, curr_, params_.k);
@@ -132,9 +133,9 @@ class SavScheme {
                                   " is not a finite number >= 0");
     const double kMax = lambda > 0.0 ? 2.0 / std::sqrt(lambda) : INFINITY;
     if (params_.k > kMax)
-      throw std::invalid_argument("time step k = " + formatNumber(params_.k) +
-                                  " breaks the stability bound (44) of the split scheme: k <= " +
-                                  formatNumber(kMax));
+      throw std::invalid_argument(
+          "time step k = " + formatNumber(params_.k) +
+          " breaks the stability bound (44) of the split scheme: k <= " + formatNumber(kMax));
   }
 
   // The potential that ψ quadratises: V' for (38), the whole V for (27).

@@ -1,12 +1,12 @@
 // The numbers every time-stepping scheme takes, their validation, and the centred loss they share.
 #pragma once
 
-#include "schemes/hamiltonian.h"
-#include "util/format_number.h"
-
 #include <cmath>
 #include <stdexcept>
 #include <string>
+
+#include "schemes/hamiltonian.h"
+#include "util/format_number.h"
 
 namespace hamiltone {
 
@@ -25,9 +25,9 @@ inline void checkStepParameters(const StepParameters& p, bool hasEpsilon) {
     throw std::invalid_argument("loss sigma0 = " + formatNumber(p.sigma0) +
                                 ": must be a finite number >= 0 (1/s)");
   if (p.sigma0 * p.k >= 1.0)
-    throw std::invalid_argument("loss sigma0 = " + formatNumber(p.sigma0) + " with k = " +
-                                formatNumber(p.k) + ": sigma0*k must be < 1, i.e. sigma0 < " +
-                                formatNumber(1.0 / p.k));
+    throw std::invalid_argument("loss sigma0 = " + formatNumber(p.sigma0) +
+                                " with k = " + formatNumber(p.k) +
+                                ": sigma0*k must be < 1, i.e. sigma0 < " + formatNumber(1.0 / p.k));
   if (!hasEpsilon && p.epsilon != 0.0)
     throw std::invalid_argument("gauge shift epsilon = " + formatNumber(p.epsilon) +
                                 ": only the SAV schemes (27), (38) take a gauge shift");
@@ -38,9 +38,9 @@ inline void checkStepParameters(const StepParameters& p, bool hasEpsilon) {
 
 inline void checkInitialState(const InitialState& s, Eigen::Index n) {
   if (s.q.size() != n || s.p.size() != n)
-    throw std::invalid_argument("initial state has " + std::to_string(s.q.size()) + " positions and " +
-                                std::to_string(s.p.size()) + " momenta; the system has " +
-                                std::to_string(n) + " coordinates");
+    throw std::invalid_argument("initial state has " + std::to_string(s.q.size()) +
+                                " positions and " + std::to_string(s.p.size()) +
+                                " momenta; the system has " + std::to_string(n) + " coordinates");
   if (!s.q.allFinite() || !s.p.allFinite())
     throw std::invalid_argument("initial state is not finite");
 }

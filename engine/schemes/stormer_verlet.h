@@ -1,10 +1,10 @@
 // Störmer–Verlet (20) with the Taylor start (21): the reference, and the baseline for cost.
 #pragma once
 
+#include <utility>
+
 #include "schemes/hamiltonian.h"
 #include "schemes/step_parameters.h"
-
-#include <utility>
 
 namespace hamiltone {
 
@@ -57,7 +57,8 @@ class StormerVerlet {
   double time() const { return static_cast<double>(n_) * params_.k; }
   const Vector& q() const { return prev_; }
   const Vector& qNext() const { return curr_; }
-  // Energy taken by the loss since the start: energy().total() + dissipated() is the energy at n = 0.
+  // Energy taken by the loss since the start: energy().total() + dissipated() is the energy at n =
+  // 0.
   double dissipated() const { return dissipated_; }
   const S& system() const { return system_; }
   const StepParameters& parameters() const { return params_; }

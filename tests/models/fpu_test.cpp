@@ -2,9 +2,9 @@
 // and its stiffness matrix has the spectrum that gives the bound (54).
 #include "models/fpu.h"
 
-#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <random>
 
 namespace hamiltone {

@@ -1,7 +1,6 @@
 // hamiltone-sim fpu as a user meets it: the CSV it writes, and every bad input refused with
 // exit code 2, one line naming the argument, and no output file.
 #include <gtest/gtest.h>
-
 #include <sys/wait.h>
 
 #include <cmath>
@@ -80,8 +79,8 @@ std::vector<std::vector<double>> parseRows(const std::string& text, std::string&
 }
 
 TEST_F(SimCli, WritesTheDocumentedCsv) {
-  const Result r = run("fpu --scheme sav-split --k 1e-3 --duration 0.01 --alpha 10 --every 3 --out " +
-                       csv());
+  const Result r =
+      run("fpu --scheme sav-split --k 1e-3 --duration 0.01 --alpha 10 --every 3 --out " + csv());
   ASSERT_EQ(r.exitCode, 0) << r.err;
   EXPECT_NE(r.out.find("max relative energy drift (51)"), std::string::npos) << r.out;
   std::string header;

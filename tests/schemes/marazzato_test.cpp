@@ -1,8 +1,8 @@
 // Marazzato et al.'s scheme (22) on FPU: the pseudo-energy (13) is exact when the quadrature
 // integrates ∇V along the free flight exactly, second order in k otherwise; (17) >= (13) by (18).
-#include "support/fpu_runs.h"
-
 #include <gtest/gtest.h>
+
+#include "support/fpu_runs.h"
 
 namespace hamiltone {
 namespace {
@@ -20,11 +20,12 @@ double pseudoEnergyDeviation(QuadratureRule rule, double k, double alpha) {
 // FPU's ∇V is cubic in q, so cubic in t along the free flight: every rule of degree >= 3
 // integrates it exactly and Theorem 1 applies. Roundoff: a few ulps per step, 1000 steps.
 TEST(Marazzato, ExactQuadratureConservesThePseudoEnergy) {
-  for (QuadratureRule rule : {QuadratureRule::gaussLegendre2, QuadratureRule::gaussLegendre3,
-                              QuadratureRule::gaussLegendre5, QuadratureRule::lobatto3,
-                              QuadratureRule::lobatto5})
+  for (QuadratureRule rule :
+       {QuadratureRule::gaussLegendre2, QuadratureRule::gaussLegendre3,
+        QuadratureRule::gaussLegendre5, QuadratureRule::lobatto3, QuadratureRule::lobatto5})
     for (double alpha : {10.0, 50.0})
-      EXPECT_LE(pseudoEnergyDeviation(rule, 1e-3, alpha), 1e-12) << name(rule) << " alpha " << alpha;
+      EXPECT_LE(pseudoEnergyDeviation(rule, 1e-3, alpha), 1e-12)
+          << name(rule) << " alpha " << alpha;
 }
 
 // With the mid-point rule the quadrature error is O(k³) per step, so (14): O(k²) overall.

@@ -1,8 +1,8 @@
 // No scheme allocates while stepping or reporting energy: Eigen's EIGEN_RUNTIME_NO_MALLOC guard,
 // armed in this binary (see tests/CMakeLists.txt), aborts on any heap allocation through Eigen.
-#include "support/fpu_runs.h"
-
 #include <gtest/gtest.h>
+
+#include "support/fpu_runs.h"
 
 namespace hamiltone {
 namespace {
@@ -48,9 +48,9 @@ TEST(NoAllocation, SplitSav) {
 }
 
 TEST(NoAllocation, MarazzatoWithEveryQuadrature) {
-  for (QuadratureRule rule : {QuadratureRule::midpoint, QuadratureRule::gaussLegendre2,
-                              QuadratureRule::gaussLegendre3, QuadratureRule::gaussLegendre5,
-                              QuadratureRule::lobatto3, QuadratureRule::lobatto5}) {
+  for (QuadratureRule rule :
+       {QuadratureRule::midpoint, QuadratureRule::gaussLegendre2, QuadratureRule::gaussLegendre3,
+        QuadratureRule::gaussLegendre5, QuadratureRule::lobatto3, QuadratureRule::lobatto5}) {
     Marazzato<FermiPastaUlam> s(chain(), {.k = 1e-3}, start(), rule);
     stepWithoutAllocating(s);
     Eigen::internal::set_is_malloc_allowed(false);

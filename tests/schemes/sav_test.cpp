@@ -1,8 +1,8 @@
 // The SAV schemes (27) and (38) on FPU: exact energy conservation (41)/(36), the loss balance (50),
 // the stability bound (44), and unconditional stability of (27) where Störmer–Verlet blows up.
-#include "support/fpu_runs.h"
-
 #include <gtest/gtest.h>
+
+#include "support/fpu_runs.h"
 
 namespace hamiltone {
 namespace {
@@ -30,7 +30,8 @@ void expectStartsAtThePhysicalEnergy(double alpha) {
   const FermiPastaUlam chain = paperChain();
   const double exact = std::pow(alpha, 4) + 2500.0 * alpha * alpha / 4.0;
   auto gap = [&](double k) {
-    return std::abs(Scheme(chain, {.k = k}, fpuInitialState(chain, alpha)).energy().total() - exact);
+    return std::abs(Scheme(chain, {.k = k}, fpuInitialState(chain, alpha)).energy().total() -
+                    exact);
   };
   EXPECT_NEAR(gap(1e-4) / gap(5e-5), 4.0, 0.1) << "alpha " << alpha;
   EXPECT_LT(gap(1e-4), 1e-3 * exact);
@@ -41,11 +42,13 @@ TEST(SplitSav, ConservesEnergyExactly) {
 }
 
 TEST(NonSplitSav, ConservesEnergyExactly) {
-  for (double alpha : {10.0, 50.0, 100.0}) expectConservesEnergy<NonSplitSav<FermiPastaUlam>>(alpha);
+  for (double alpha : {10.0, 50.0, 100.0})
+    expectConservesEnergy<NonSplitSav<FermiPastaUlam>>(alpha);
 }
 
 TEST(SplitSav, ConservedEnergyIsThePhysicalOneToSecondOrder) {
-  for (double alpha : {10.0, 100.0}) expectStartsAtThePhysicalEnergy<SplitSav<FermiPastaUlam>>(alpha);
+  for (double alpha : {10.0, 100.0})
+    expectStartsAtThePhysicalEnergy<SplitSav<FermiPastaUlam>>(alpha);
 }
 
 TEST(NonSplitSav, ConservedEnergyIsThePhysicalOneToSecondOrder) {
@@ -56,7 +59,8 @@ TEST(NonSplitSav, ConservedEnergyIsThePhysicalOneToSecondOrder) {
 TEST(SplitSav, GaugeShiftKeepsConservationAndIsExcludedFromTheReportedEnergy) {
   const FermiPastaUlam chain = paperChain();
   SplitSav<FermiPastaUlam> plain(chain, {.k = 1e-3}, fpuInitialState(chain, 10.0));
-  SplitSav<FermiPastaUlam> shifted(chain, {.k = 1e-3, .epsilon = 1.0}, fpuInitialState(chain, 10.0));
+  SplitSav<FermiPastaUlam> shifted(chain, {.k = 1e-3, .epsilon = 1.0},
+                                   fpuInitialState(chain, 10.0));
   const auto h = energies(shifted, 1000);
   EXPECT_LE(maxRelativeDeviation(h), 1e-12);
   // ψ²/2 − ε still starts at V'(q^{½}): the two energies agree to roundoff of ψ²/2 ≈ V' + ε.
@@ -84,7 +88,9 @@ void expectBalancedLoss() {
   EXPECT_GT(scheme.dissipated(), 0.9 * h0);
 }
 
-TEST(SplitSav, LossNeverAddsEnergyAndTheBalanceCloses) { expectBalancedLoss<SplitSav<FermiPastaUlam>>(); }
+TEST(SplitSav, LossNeverAddsEnergyAndTheBalanceCloses) {
+  expectBalancedLoss<SplitSav<FermiPastaUlam>>();
+}
 
 TEST(NonSplitSav, LossNeverAddsEnergyAndTheBalanceCloses) {
   expectBalancedLoss<NonSplitSav<FermiPastaUlam>>();

@@ -1,8 +1,8 @@
 // Störmer–Verlet (20): under V' ≡ 0 the split scheme (38) is exactly Störmer–Verlet (BDZ §3.5),
 // and then SV conserves (41) with ψ = 0.
-#include "support/fpu_runs.h"
-
 #include <gtest/gtest.h>
+
+#include "support/fpu_runs.h"
 
 namespace hamiltone {
 namespace {

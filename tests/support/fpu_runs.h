@@ -1,14 +1,14 @@
 // Runs of the schemes on the FPU chain that several tests share.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
 #include "models/fpu.h"
 #include "schemes/marazzato.h"
 #include "schemes/sav.h"
 #include "schemes/stormer_verlet.h"
-
-#include <algorithm>
-#include <cmath>
-#include <vector>
 
 namespace hamiltone::testing {
 
