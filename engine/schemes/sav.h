@@ -47,61 +47,10 @@ class SavScheme {
   // Sherman–Morrison (33), then ψ^{n+½} by (38c). In the paper's naming the members hold
   // q^{n−1} = prev_, q^n = curr_, q^{n+1} = next_ during the step.
   void step() noexcept {
-    const double k = params_.k;
-    const double up = 1.0 + params_.sigma0 * k;
-    const double down = 1.0 - params_.sigma0 * k;
-    const Eigen::Index n = system_.size();
-    const double* minv = system_.inverseMass().data();
-    const double* mass = mass_.data();
-    const double* qm = prev_.data();
-    const double* q = curr_.data();
-    double* qp = next_.data();
-    const double* gv = grad_.data();
-    const double* kq = kq_.data();
-
-    // (39): g = ∇V' / sqrt(2 (V' + ε)), g = 0 where V' + ε = 0. grad_ holds ∇V', g = s ∇V'.
-    const double shifted = gradient() + params_.epsilon;
-    const double s = shifted > 0.0 ? 1.0 / std::sqrt(2.0 * shifted) : 0.0;
-    const double h = 0.5 * k * s;  // α = h M⁻¹∇V',  β = h ∇V'   (31)
-
-    double gqm = 0.0, gMg = 0.0;
-    for (Eigen::Index i = 0; i < n; ++i) {
-      gqm += gv[i] * qm[i];
-      gMg += gv[i] * minv[i] * gv[i];
-    }
-    const double btqm = h * gqm;     // βᵀ q^{n−1}
-    const double bta = h * h * gMg;  // βᵀ α
-    const double kk = k * k;
-    const double twoKPsi = 2.0 * k * psi_;
-
-    // (40) with the loss of (49): b = (2I − k²M⁻¹K) q^n − 2kψ α − ((1−σ0k) I − αβᵀ) q^{n−1}
-    double gb = 0.0;
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const double a = h * minv[i] * gv[i];
-      double b = 2.0 * q[i] - twoKPsi * a - down * qm[i] + a * btqm;
-      if constexpr (splitK) b -= kk * (minv[i] * kq[i]);
-      qp[i] = b;
-      gb += gv[i] * b;
-    }
-
-    // (33) with A0 = (1+σ0k) I: q^{n+1} = (b − α βᵀb / (1+σ0k + βᵀα)) / (1+σ0k)
-    const double coef = h * gb / (up + bta);
-    const double invUp = 1.0 / up;
-    double gdq = 0.0;
-    double lost = 0.0;
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const double x = (qp[i] - h * minv[i] * gv[i] * coef) * invUp;
-      qp[i] = x;
-      const double d = x - qm[i];
-      gdq += gv[i] * d;
-      lost += d * d * mass[i];
-    }
-    psi_ += 0.5 * s * gdq;                             // (38c)
-    dissipated_ += params_.sigma0 / (2.0 * k) * lost;  // (50)
-
-    prev_.swap(curr_);
-    curr_.swap(next_);
-    ++n_;
+    if (params_.sigma0 > 0.0)
+      stepInternal<true>();
+    else
+      stepInternal<false>();
   }
 
   // (41) [(36) when nonSplit], at level n: kinetic ½(δq)ᵀM(δq)/k², potential ½ q^{n+1}ᵀK q^n + ½ψ²
@@ -125,6 +74,68 @@ class SavScheme {
   const StepParameters& parameters() const { return params_; }
 
  private:
+  // The step, with the loss branch lifted out of the loops. Two passes over the grid: the first
+  // gathers the dot products that (33) needs, the second writes q^{n+1}. The reductions are
+  // vectorised (`omp simd`, with -fopenmp-simd): a fixed, deterministic summation order.
+  template <bool lossy>
+  void stepInternal() noexcept {
+    const double k = params_.k;
+    const double up = 1.0 + params_.sigma0 * k;
+    const double down = 1.0 - params_.sigma0 * k;
+    const double kk = k * k;
+    const Eigen::Index n = system_.size();
+    const double* minv = system_.inverseMass().data();
+    const double* mass = mass_.data();
+    const double* qm = prev_.data();
+    const double* q = curr_.data();
+    double* qp = next_.data();
+    const double* gv = grad_.data();
+    const double* kq = kq_.data();
+
+    // (39): g = ∇V' / sqrt(2 (V' + ε)), g = 0 where V' + ε = 0. grad_ holds ∇V', g = s ∇V'.
+    const double shifted = gradient() + params_.epsilon;
+    const double s = shifted > 0.0 ? 1.0 / std::sqrt(2.0 * shifted) : 0.0;
+    const double h = 0.5 * k * s;  // α = h M⁻¹∇V',  β = h ∇V'   (31)
+
+    double gq = 0.0, gqm = 0.0, gMg = 0.0, gMKq = 0.0;
+#pragma omp simd reduction(+ : gq, gqm, gMg, gMKq)
+    for (Eigen::Index i = 0; i < n; ++i) {
+      gq += gv[i] * q[i];
+      gqm += gv[i] * qm[i];
+      gMg += gv[i] * minv[i] * gv[i];
+      if constexpr (splitK) gMKq += gv[i] * (minv[i] * kq[i]);
+    }
+    const double btqm = h * gqm;     // βᵀ q^{n−1}
+    const double bta = h * h * gMg;  // βᵀ α
+    // (40) with the loss of (49):
+    //   b = (2I − k²M⁻¹K) q^n − 2kψ α − ((1−σ0k) I − αβᵀ) q^{n−1},
+    // of which Sherman–Morrison (33) needs βᵀb, here assembled from the dot products above.
+    const double twoKPsi = 2.0 * k * psi_;
+    const double gb = 2.0 * gq - twoKPsi * h * gMg - down * gqm + h * gMg * btqm - kk * gMKq;
+    const double coef = h * gb / (up + bta);  // βᵀb / (1+σ0k + βᵀα)
+
+    // (33) with A0 = (1+σ0k) I: q^{n+1} = (b − α coef) / (1+σ0k); α's multiples collected in c.
+    const double c = h * (btqm - twoKPsi - coef);
+    const double invUp = 1.0 / up;
+    double gdq = 0.0, lost = 0.0;
+#pragma omp simd reduction(+ : gdq, lost)
+    for (Eigen::Index i = 0; i < n; ++i) {
+      double b = 2.0 * q[i] - down * qm[i];
+      if constexpr (splitK) b -= kk * (minv[i] * kq[i]);
+      const double x = (b + c * (minv[i] * gv[i])) * invUp;
+      qp[i] = x;
+      const double d = x - qm[i];
+      gdq += gv[i] * d;
+      if constexpr (lossy) lost += d * d * mass[i];
+    }
+    psi_ += 0.5 * s * gdq;                                             // (38c)
+    if constexpr (lossy) dissipated_ += params_.sigma0 / (2.0 * k) * lost;  // (50)
+
+    prev_.swap(curr_);
+    curr_.swap(next_);
+    ++n_;
+  }
+
   // (44): k <= 2 / sqrt(λmax(M^-½ K M^-½)), else the energy (41) has no sign and no bound.
   void checkStabilityBound() const {
     const double lambda = system_.stiffnessEigenvalueMax();
