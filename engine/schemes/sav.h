@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "schemes/hamiltonian.h"
+#include "schemes/linear_loss.h"
 #include "schemes/step_parameters.h"
 
 namespace hamiltone {
@@ -16,28 +17,24 @@ enum class SavForm { nonSplit, split };
 // Time levels: after construction and after every step the scheme holds q^n, q^{n+1} and
 // ψ^{n+½} and reports level n — t = n k, q^n, and the energy H^{n+½} of (36)/(41).
 // The reported potential excludes the gauge shift ε: ½ψ² − ε ≈ V'(q^{n+½}).
-// Loss: mass-proportional, centred as in (49); its left matrix (1+σ0k) I + αβᵀ is still
-// inverted by Sherman–Morrison, and the balance (50) holds exactly (dissipated()).
+// Loss (linear_loss.h): σ0 centred as in (49), so the left matrix (1+σ0k) I + αβᵀ is still
+// inverted by Sherman–Morrison; σ1 explicit. The balance (50) holds exactly (dissipated()).
 template <HamiltonianSystem S, SavForm form>
 class SavScheme {
   static constexpr bool splitK = form == SavForm::split && S::hasStiffness;
 
  public:
   SavScheme(S system, const StepParameters& params, const InitialState& start)
-      : system_(std::move(system)), params_(params) {
+      : system_(std::move(system)), params_(params), loss_(system_, params) {
     checkStepParameters(params_, /*hasEpsilon=*/true);
     const Eigen::Index n = system_.size();
     checkInitialState(start, n);
     if constexpr (splitK) checkStabilityBound();
     for (Vector* v : {&prev_, &curr_, &next_, &grad_, &kq_}) v->setZero(n);
-    const Vector& minv = system_.inverseMass();
-    mass_ = minv.cwiseInverse();
-    const double k = params_.k;
-    // (21), with the damping term of q'' = −M⁻¹∇V − 2σ0 q'; leaves K q^0 in kq_.
+    // (21); leaves K q^0 in kq_.
     prev_ = start.q;
     fullGradient(system_, prev_, grad_, kq_);
-    curr_ = prev_ + k * (1.0 - params_.sigma0 * k) * minv.cwiseProduct(start.p) -
-            0.5 * k * k * minv.cwiseProduct(grad_);
+    loss_.taylorStart(system_, start, grad_, curr_);
     // ψ^{½} = sqrt(2 (V'(q^{½}) + ε)) with q^{½} = (q^0 + q^1)/2: second order, like (32).
     next_ = 0.5 * (prev_ + curr_);
     psi_ = std::sqrt(2.0 * (quadratisedPotential(next_) + params_.epsilon));
@@ -47,7 +44,7 @@ class SavScheme {
   // Sherman–Morrison (33), then ψ^{n+½} by (38c). In the paper's naming the members hold
   // q^{n−1} = prev_, q^n = curr_, q^{n+1} = next_ during the step.
   void step() noexcept {
-    if (params_.sigma0 > 0.0)
+    if (loss_.any())
       stepInternal<true>();
     else
       stepInternal<false>();
@@ -57,7 +54,8 @@ class SavScheme {
   // − ε.
   Energy energy() const {
     Energy e;
-    e.kinetic = intervalKineticEnergy(system_.inverseMass(), prev_, curr_, params_.k);
+    e.kinetic = intervalKineticEnergy(system_.inverseMass(), prev_, curr_, params_.k) +
+                loss_.kineticCorrection(system_, prev_, curr_);
     e.potential = 0.5 * psi_ * psi_ - params_.epsilon;
     if constexpr (splitK) e.potential += 0.5 * curr_.dot(kq_);
     return e;
@@ -85,7 +83,6 @@ class SavScheme {
     const double kk = k * k;
     const Eigen::Index n = system_.size();
     const double* minv = system_.inverseMass().data();
-    const double* mass = mass_.data();
     const double* qm = prev_.data();
     const double* q = curr_.data();
     double* qp = next_.data();
@@ -97,52 +94,59 @@ class SavScheme {
     const double s = shifted > 0.0 ? 1.0 / std::sqrt(2.0 * shifted) : 0.0;
     const double h = 0.5 * k * s;  // α = h M⁻¹∇V',  β = h ∇V'   (31)
 
-    double gq = 0.0, gqm = 0.0, gMg = 0.0, gMKq = 0.0;
-#pragma omp simd reduction(+ : gq, gqm, gMg, gMKq)
+    const double twoSigma1K = 2.0 * params_.sigma1 * k;
+    const double* cq = lossy ? loss_.frequencyForce(system_, curr_, prev_).data() : nullptr;
+
+    double gq = 0.0, gqm = 0.0, gMg = 0.0, gMKq = 0.0, gMCq = 0.0;
+#pragma omp simd reduction(+ : gq, gqm, gMg, gMKq, gMCq)
     for (Eigen::Index i = 0; i < n; ++i) {
       gq += gv[i] * q[i];
       gqm += gv[i] * qm[i];
       gMg += gv[i] * minv[i] * gv[i];
       if constexpr (splitK) gMKq += gv[i] * (minv[i] * kq[i]);
+      if constexpr (lossy) gMCq += gv[i] * (minv[i] * cq[i]);
     }
     const double btqm = h * gqm;     // βᵀ q^{n−1}
     const double bta = h * h * gMg;  // βᵀ α
-    // (40) with the loss of (49):
-    //   b = (2I − k²M⁻¹K) q^n − 2kψ α − ((1−σ0k) I − αβᵀ) q^{n−1},
+    // (40) with the loss (49) and the σ1 term:
+    //   b = (2I − k²M⁻¹K) q^n − 2kψ α − ((1−σ0k) I − αβᵀ) q^{n−1} − 2σ1k M⁻¹C (q^n − q^{n−1}),
     // of which Sherman–Morrison (33) needs βᵀb, here assembled from the dot products above.
     const double twoKPsi = 2.0 * k * psi_;
-    const double gb = 2.0 * gq - twoKPsi * h * gMg - down * gqm + h * gMg * btqm - kk * gMKq;
+    const double gb = 2.0 * gq - twoKPsi * h * gMg - down * gqm + h * gMg * btqm - kk * gMKq -
+                      twoSigma1K * gMCq;
     const double coef = h * gb / (up + bta);  // βᵀb / (1+σ0k + βᵀα)
 
     // (33) with A0 = (1+σ0k) I: q^{n+1} = (b − α coef) / (1+σ0k); α's multiples collected in c.
     const double c = h * (btqm - twoKPsi - coef);
     const double invUp = 1.0 / up;
-    double gdq = 0.0, lost = 0.0;
-#pragma omp simd reduction(+ : gdq, lost)
+    double gdq = 0.0;
+#pragma omp simd reduction(+ : gdq)
     for (Eigen::Index i = 0; i < n; ++i) {
       double b = 2.0 * q[i] - down * qm[i];
       if constexpr (splitK) b -= kk * (minv[i] * kq[i]);
+      if constexpr (lossy) b -= twoSigma1K * (minv[i] * cq[i]);
       const double x = (b + c * (minv[i] * gv[i])) * invUp;
       qp[i] = x;
-      const double d = x - qm[i];
-      gdq += gv[i] * d;
-      if constexpr (lossy) lost += d * d * mass[i];
+      gdq += gv[i] * (x - qm[i]);
     }
-    psi_ += 0.5 * s * gdq;                                             // (38c)
-    if constexpr (lossy) dissipated_ += params_.sigma0 / (2.0 * k) * lost;  // (50)
+    psi_ += 0.5 * s * gdq;  // (38c)
+    if constexpr (lossy) dissipated_ += loss_.dissipation(system_, next_, prev_);  // (50)
 
     prev_.swap(curr_);
     curr_.swap(next_);
     ++n_;
   }
 
-  // (44): k <= 2 / sqrt(λmax(M^-½ K M^-½)), else the energy (41) has no sign and no bound.
+  // (44): k <= 2 / sqrt(λmax(M^-½ K M^-½)), else the energy (41) has no sign and no bound;
+  // with σ1 > 0 the bound of maxStableStep.
   void checkStabilityBound() const {
     const double lambda = system_.stiffnessEigenvalueMax();
     if (!(lambda >= 0.0) || !std::isfinite(lambda))
       throw std::invalid_argument("stiffness eigenvalue bound " + formatNumber(lambda) +
                                   " is not a finite number >= 0");
-    const double kMax = lambda > 0.0 ? 2.0 / std::sqrt(lambda) : INFINITY;
+    double lambdaL = 0.0;
+    if constexpr (HasLossOperator<S>) lambdaL = system_.lossOperatorEigenvalueMax();
+    const double kMax = maxStableStep(lambda, lambdaL, params_.sigma1);
     if (params_.k > kMax)
       throw std::invalid_argument(
           "time step k = " + formatNumber(params_.k) +
@@ -164,9 +168,9 @@ class SavScheme {
 
   S system_;
   StepParameters params_;
+  LinearLoss<S> loss_;
   Vector prev_, curr_, next_;  // q^n, q^{n+1}, workspace; rotated by swapping
   Vector grad_, kq_;           // ∇V' (∇V) and K q at the newest level a step used
-  Vector mass_;                // diagonal of M
   double psi_ = 0.0;           // ψ^{n+½}
   double dissipated_ = 0.0;
   long n_ = 0;

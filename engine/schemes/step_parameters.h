@@ -1,4 +1,4 @@
-// The numbers every time-stepping scheme takes, their validation, and the centred loss they share.
+// The numbers every time-stepping scheme takes, and their validation.
 #pragma once
 
 #include <cmath>
@@ -13,6 +13,7 @@ namespace hamiltone {
 struct StepParameters {
   double k = 0.0;        // time step, s
   double sigma0 = 0.0;   // mass-proportional loss: force −2σ0 M q', 1/s   (6), (49)
+  double sigma1 = 0.0;   // frequency-dependent loss: force −2σ1 M(−L) q', m²/s (linear_loss.h)
   double epsilon = 0.0;  // gauge shift of the quadratised potential, §2.5 (SAV schemes only)
 };
 
@@ -28,6 +29,9 @@ inline void checkStepParameters(const StepParameters& p, bool hasEpsilon) {
     throw std::invalid_argument("loss sigma0 = " + formatNumber(p.sigma0) +
                                 " with k = " + formatNumber(p.k) +
                                 ": sigma0*k must be < 1, i.e. sigma0 < " + formatNumber(1.0 / p.k));
+  if (!std::isfinite(p.sigma1) || p.sigma1 < 0.0)
+    throw std::invalid_argument("loss sigma1 = " + formatNumber(p.sigma1) +
+                                ": must be a finite number >= 0 (m^2/s)");
   if (!hasEpsilon && p.epsilon != 0.0)
     throw std::invalid_argument("gauge shift epsilon = " + formatNumber(p.epsilon) +
                                 ": only the SAV schemes (27), (38) take a gauge shift");
@@ -43,14 +47,6 @@ inline void checkInitialState(const InitialState& s, Eigen::Index n) {
                                 " momenta; the system has " + std::to_string(n) + " coordinates");
   if (!s.q.allFinite() || !s.p.allFinite())
     throw std::invalid_argument("initial state is not finite");
-}
-
-// σ0/(2k) ‖q^{n+1} − q^{n−1}‖²_M: the energy the centred loss takes in one step,
-// from the balance (50) with M R = 2σ0 I and p^{n+½} + p^{n−½} = M (q^{n+1} − q^{n−1}) / k.
-inline double centredLossDissipation(const StepParameters& p, const Vector& inverseMass,
-                                     const Vector& qNext, const Vector& qPrev) noexcept {
-  if (p.sigma0 == 0.0) return 0.0;
-  return p.sigma0 / (2.0 * p.k) * ((qNext - qPrev).array().square() / inverseMass.array()).sum();
 }
 
 }  // namespace hamiltone

@@ -4,41 +4,45 @@
 #include <utility>
 
 #include "schemes/hamiltonian.h"
+#include "schemes/linear_loss.h"
 #include "schemes/step_parameters.h"
 
 namespace hamiltone {
 
 // Time levels: after construction and after every step the scheme holds q^n and q^{n+1} and
 // reports level n — t = n k, q^n, and the energy H^{n+½} of the interval [t^n, t^{n+1}].
-// Loss: mass-proportional damping −2σ0 M q', centred as in (49), so that with V' ≡ 0 this is
-// exactly the split scheme (38).
+// Loss: as the split scheme's (linear_loss.h), so that with V' ≡ 0 this is exactly (38).
 template <HamiltonianSystem S>
 class StormerVerlet {
  public:
   StormerVerlet(S system, const StepParameters& params, const InitialState& start)
-      : system_(std::move(system)), params_(params) {
+      : system_(std::move(system)), params_(params), loss_(system_, params) {
     checkStepParameters(params_, /*hasEpsilon=*/false);
     const Eigen::Index n = system_.size();
     checkInitialState(start, n);
     for (Vector* v : {&prev_, &curr_, &next_, &grad_, &kq_}) v->setZero(n);
-    // (21), with the damping term of q'' = −M⁻¹∇V − 2σ0 q'.
-    const double k = params_.k;
-    const Vector& minv = system_.inverseMass();
     prev_ = start.q;
     vPrime_ = gradient(prev_);
-    curr_ = prev_ + k * (1.0 - params_.sigma0 * k) * minv.cwiseProduct(start.p) -
-            0.5 * k * k * minv.cwiseProduct(grad_);
+    loss_.taylorStart(system_, start, grad_, curr_);  // (21)
   }
 
   void step() noexcept {
     const double k = params_.k;
     const double invUp = 1.0 / (1.0 + params_.sigma0 * k);
     const double down = 1.0 - params_.sigma0 * k;
+    const double twoSigma1K = 2.0 * params_.sigma1 * k;
     const Vector& minv = system_.inverseMass();
     vPrime_ = gradient(curr_);
-    // (20), centred loss: (1+σ0k) q^{n+1} = 2q^n − (1−σ0k) q^{n−1} − k² M⁻¹ ∇V(q^n)
-    next_ = (2.0 * curr_ - down * prev_ - (k * k) * minv.cwiseProduct(grad_)) * invUp;
-    dissipated_ += centredLossDissipation(params_, minv, next_, prev_);
+    const Vector& cq = loss_.frequencyForce(system_, curr_, prev_);
+    // (20) with the loss: (1+σ0k) q^{n+1} = 2q^n − (1−σ0k) q^{n−1} − k² M⁻¹∇V(q^n)
+    //                                        − 2σ1k M⁻¹C (q^n − q^{n−1})
+    if (params_.sigma1 > 0.0)
+      next_ = (2.0 * curr_ - down * prev_ - (k * k) * minv.cwiseProduct(grad_) -
+               twoSigma1K * minv.cwiseProduct(cq)) *
+              invUp;
+    else
+      next_ = (2.0 * curr_ - down * prev_ - (k * k) * minv.cwiseProduct(grad_)) * invUp;
+    if (loss_.any()) dissipated_ += loss_.dissipation(system_, next_, prev_);
     prev_.swap(curr_);
     curr_.swap(next_);
     ++n_;
@@ -47,7 +51,8 @@ class StormerVerlet {
   // (41) with ψ = 0, plus V'(q^n): the energy SV would conserve were V' ≡ 0.
   Energy energy() const {
     Energy e;
-    e.kinetic = intervalKineticEnergy(system_.inverseMass(), prev_, curr_, params_.k);
+    e.kinetic = intervalKineticEnergy(system_.inverseMass(), prev_, curr_, params_.k) +
+                loss_.kineticCorrection(system_, prev_, curr_);
     e.potential = vPrime_;
     if constexpr (S::hasStiffness) e.potential += 0.5 * curr_.dot(kq_);
     return e;
@@ -76,6 +81,7 @@ class StormerVerlet {
 
   S system_;
   StepParameters params_;
+  LinearLoss<S> loss_;
   Vector prev_, curr_, next_;  // q^n, q^{n+1}, workspace; rotated by swapping
   Vector grad_, kq_;           // ∇V and K q at the newest level a step used
   double vPrime_ = 0.0;        // V'(q^n)

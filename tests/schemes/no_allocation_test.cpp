@@ -2,6 +2,9 @@
 // armed in this binary (see tests/CMakeLists.txt), aborts on any heap allocation through Eigen.
 #include <gtest/gtest.h>
 
+#include <numbers>
+
+#include "models/hammer.h"
 #include "support/fpu_runs.h"
 
 namespace hamiltone {
@@ -45,6 +48,23 @@ TEST(NoAllocation, NonSplitSav) {
 TEST(NoAllocation, SplitSav) {
   SplitSav<FermiPastaUlam> s(chain(), {.k = 1e-3, .sigma0 = 1.0, .epsilon = 1.0}, start());
   stepWithoutAllocating(s);
+}
+
+// The struck string with both losses: the stencils, the hammer contact and the σ1 operator.
+TEST(NoAllocation, SplitSavOnTheStruckString) {
+  StringPhysics physics;
+  physics.inertia = std::numbers::pi * std::pow(1.063e-3, 4) / 64.0;
+  const double k = 1.0 / 48000.0;
+  const HammeredString system(
+      NonlinearString(physics, gridSegments(physics, GridRule::transverse, k, 1e-3, 1.0)),
+      HammerFelt{});
+  InitialState start{Vector::Zero(system.size()), Vector::Zero(system.size())};
+  start.q[system.hammerIndex()] = -1e-4;
+  start.p[system.hammerIndex()] = 0.03;
+  SplitSav<HammeredString> sav(system, {.k = k, .sigma0 = 1.0, .sigma1 = 1e-3}, start);
+  stepWithoutAllocating(sav);
+  StormerVerlet<HammeredString> sv(system, {.k = k, .sigma0 = 1.0, .sigma1 = 1e-3}, start);
+  stepWithoutAllocating(sv);
 }
 
 TEST(NoAllocation, MarazzatoWithEveryQuadrature) {

@@ -1,0 +1,135 @@
+// The string model: ∇V' is the derivative of V' (65), K has the closed-form spectrum the tuning
+// and the bound (44) rely on, the loss operator is −ρA h D2, and unphysical strings are refused.
+#include "models/string.h"
+
+#include <Eigen/Eigenvalues>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <random>
+
+namespace hamiltone {
+namespace {
+
+// The paper's C3 string (BDZ §4.2.3) with its steel core's bending stiffness, d = 1.063 mm.
+StringPhysics c3(bool stiff = true) {
+  StringPhysics p;
+  if (stiff) p.inertia = std::numbers::pi * std::pow(1.063e-3, 4) / 64.0;
+  return p;
+}
+
+Vector randomState(Eigen::Index n, double scale, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-scale, scale);
+  Vector q(n);
+  for (auto& x : q) x = u(rng);
+  return q;
+}
+
+Eigen::MatrixXd matrixOf(const NonlinearString& s, auto apply) {
+  const Eigen::Index n = s.size();
+  Eigen::MatrixXd a(n, n);
+  Vector e(n), col(n);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    e.setZero();
+    e[j] = 1.0;
+    apply(e, col);
+    a.col(j) = col;
+  }
+  return a;
+}
+
+// Random states of a few mm transverse and a few µm longitudinal, like a struck piano string;
+// a relative 1e-6 against central differences leaves room for O(δ²) and for roundoff ~ 1e-16 V'/δ.
+TEST(NonlinearString, GradientIsTheDerivativeOfTheSplitPotential) {
+  const NonlinearString string(c3(), 40);
+  const Eigen::Index n = string.size(), half = n / 2;
+  Vector grad(n);
+  for (unsigned seed = 0; seed < 4; ++seed) {
+    Vector q = randomState(n, 3e-3, seed);
+    q.tail(half) *= 1e-3;
+    const double v = string.splitGradient(q, grad);
+    EXPECT_DOUBLE_EQ(v, string.splitPotential(q));
+    const double scale = grad.cwiseAbs().maxCoeff();
+    for (Eigen::Index j = 0; j < n; ++j) {
+      const double delta = j < half ? 1e-7 : 1e-10;
+      const double saved = q[j];
+      q[j] = saved + delta;
+      const double up = string.splitPotential(q);
+      q[j] = saved - delta;
+      const double down = string.splitPotential(q);
+      q[j] = saved;
+      EXPECT_NEAR(grad[j], (up - down) / (2.0 * delta), 1e-6 * scale) << "coordinate " << j;
+    }
+  }
+}
+
+TEST(NonlinearString, SplitPotentialIsTheGeometricExcessEnergy) {
+  // u_1 = a alone: segments 1 and 2 get ζ = ±a/h and η = 0, so s − 1 = (a/h)² / (s + 1).
+  const NonlinearString string(c3(false), 4);
+  Vector q = Vector::Zero(string.size());
+  const double a = 1e-3, h = string.spacing();
+  q[0] = a;
+  const double z2 = (a / h) * (a / h);
+  const double excess = z2 / (std::sqrt(1.0 + z2) + 1.0);
+  const double expected = h * (2.02e11 * 8.87e-7 - 759.0) / 2.0 * 2.0 * excess * excess;
+  EXPECT_NEAR(string.splitPotential(q), expected, 1e-12 * expected);
+}
+
+TEST(NonlinearString, StiffnessHasTheClosedFormSpectrum) {
+  const NonlinearString string(c3(), 30);
+  const Eigen::MatrixXd k =
+      matrixOf(string, [&](const Vector& x, Vector& y) { string.applyStiffness(x, y); });
+  EXPECT_LE((k - k.transpose()).cwiseAbs().maxCoeff(), 1e-12 * k.cwiseAbs().maxCoeff());
+  // M⁻¹K eigenvalues: the transverse and the longitudinal families of the header.
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(k * string.inverseMass()[0]);
+  std::vector<double> expected;
+  for (int m = 1; m < string.segments(); ++m) {
+    expected.push_back(string.transverseEigenvalue(m));
+    expected.push_back(string.longitudinalEigenvalue(m));
+  }
+  std::sort(expected.begin(), expected.end());
+  for (size_t i = 0; i < expected.size(); ++i)
+    EXPECT_NEAR(eig.eigenvalues()[static_cast<Eigen::Index>(i)], expected[i], 1e-9 * expected.back());
+  EXPECT_NEAR(eig.eigenvalues().maxCoeff(), string.stiffnessEigenvalueMax(), 1e-9 * expected.back());
+}
+
+TEST(NonlinearString, LossOperatorIsMinusRhoAhD2OfTheDifference) {
+  const NonlinearString string(c3(), 12);
+  const Eigen::Index n = string.size();
+  const Vector a = randomState(n, 1.0, 7), b = randomState(n, 1.0, 8);
+  Vector out(n);
+  string.applyLossOperator(a, b, out);
+  const Eigen::MatrixXd c = matrixOf(string, [&](const Vector& x, Vector& y) {
+    string.applyLossOperator(x, Vector::Zero(n), y);
+  });
+  EXPECT_LE((c * (a - b) - out).cwiseAbs().maxCoeff(), 1e-12 * out.cwiseAbs().maxCoeff());
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(c * string.inverseMass()[0]);
+  EXPECT_GE(eig.eigenvalues().minCoeff(), 0.0);
+  EXPECT_NEAR(eig.eigenvalues().maxCoeff(), string.lossOperatorEigenvalueMax(),
+              1e-9 * string.lossOperatorEigenvalueMax());
+}
+
+TEST(NonlinearString, RefusesUnphysicalStrings) {
+  auto with = [](auto change) {
+    StringPhysics p = c3();
+    change(p);
+    return p;
+  };
+  EXPECT_THROW(NonlinearString(with([](auto& p) { p.density = 0; }), 10), std::invalid_argument);
+  EXPECT_THROW(NonlinearString(with([](auto& p) { p.area = -1; }), 10), std::invalid_argument);
+  EXPECT_THROW(NonlinearString(with([](auto& p) { p.length = NAN; }), 10), std::invalid_argument);
+  EXPECT_THROW(NonlinearString(with([](auto& p) { p.inertia = -1; }), 10), std::invalid_argument);
+  try {
+    NonlinearString(with([](auto& p) { p.tension = 2e5; }), 10);  // EA ≈ 1.79e5 N
+    FAIL() << "EA <= T0 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("tension"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(NonlinearString(c3(), 1), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace hamiltone
