@@ -1,15 +1,15 @@
 // Time per step of SV (20), SAV (27)/(38) and Marazzato (22) on the FPU chain; ratios to SV.
-#include "models/fpu.h"
-#include "schemes/marazzato.h"
-#include "schemes/sav.h"
-#include "schemes/stormer_verlet.h"
-
 #include <benchmark/benchmark.h>
 
 #include <cstdio>
 #include <map>
 #include <string>
 #include <vector>
+
+#include "models/fpu.h"
+#include "schemes/marazzato.h"
+#include "schemes/sav.h"
+#include "schemes/stormer_verlet.h"
 
 namespace hamiltone {
 namespace {

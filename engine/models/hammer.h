@@ -10,11 +10,11 @@
 namespace hamiltone {
 
 struct HammerFelt {
-  double mass = 9.45e-3;      // M_H, kg            (RT-425 law at C3, piano-and-plate-data §2.1)
-  double stiffness = 1.347e9; // K_H, N/m^p
-  double exponent = 2.312;    // p
-  double position = 0.12;     // strike point x0 / L
-  double width = 0.01;        // contact width on the string, m
+  double mass = 9.45e-3;       // M_H, kg            (RT-425 law at C3, piano-and-plate-data §2.1)
+  double stiffness = 1.347e9;  // K_H, N/m^p
+  double exponent = 2.312;     // p
+  double position = 0.12;      // strike point x0 / L
+  double width = 0.01;         // contact width on the string, m
 };
 
 // Φ(η) = K_H/(p+1) [η]₊^{p+1} of the felt compression η = w − Jᵀu, and its force Φ'(η).
@@ -54,7 +54,7 @@ class HammeredString {
   void applyLossOperator(const Vector& a, const Vector& b, Vector& out) const;
   double lossOperatorEigenvalueMax() const { return string_.lossOperatorEigenvalueMax(); }
 
-  double compression(const Vector& q) const;  // η = w − Jᵀu
+  double compression(const Vector& q) const;          // η = w − Jᵀu
   double contactDisplacement(const Vector& q) const;  // Jᵀu
 
  private:
@@ -62,7 +62,7 @@ class HammeredString {
   Hammer hammer_;
   Vector inverseMass_;
   std::vector<Eigen::Index> contactIndex_;  // grid indices of u under the felt
-  std::vector<double> contactWeight_;      // J there
+  std::vector<double> contactWeight_;       // J there
 };
 
 }  // namespace hamiltone

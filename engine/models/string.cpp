@@ -169,9 +169,12 @@ int gridSegments(const StringPhysics& p, GridRule rule, double k, double sigma1,
   const double h = factor * minimalSpacing(p, rule, k, sigma1);
   const double segments = std::floor(p.length / h);
   if (!(segments >= 2.0))
-    throw std::invalid_argument("length = " + formatNumber(p.length) + " m: shorter than two grid "
-                                "spacings h = " + formatNumber(h) + " m at k = " + formatNumber(k) +
-                                " s; use a smaller time step (oversampling) or a smaller grid factor");
+    throw std::invalid_argument(
+        "length = " + formatNumber(p.length) +
+        " m: shorter than two grid "
+        "spacings h = " +
+        formatNumber(h) + " m at k = " + formatNumber(k) +
+        " s; use a smaller time step (oversampling) or a smaller grid factor");
   if (segments > 1e6)
     throw std::invalid_argument("the grid would have " + formatNumber(segments) +
                                 " segments; expected at most 1e6 (use a larger time step)");

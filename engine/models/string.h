@@ -7,12 +7,12 @@
 namespace hamiltone {
 
 struct StringPhysics {
-  double density = 7850.0;    // ρ, kg/m³
-  double area = 8.87e-7;      // A, m²
-  double length = 1.259;      // L, m
-  double young = 2.02e11;     // E, Pa
-  double tension = 759.0;     // T0, N
-  double inertia = 0.0;       // I of the cross-section for bending, m⁴ (0: no stiffness)
+  double density = 7850.0;  // ρ, kg/m³
+  double area = 8.87e-7;    // A, m²
+  double length = 1.259;    // L, m
+  double young = 2.02e11;   // E, Pa
+  double tension = 759.0;   // T0, N
+  double inertia = 0.0;     // I of the cross-section for bending, m⁴ (0: no stiffness)
   double linearDensity() const { return density * area; }  // ρA, kg/m
 };
 
@@ -69,6 +69,7 @@ enum class GridRule {
 double minimalSpacing(const StringPhysics& physics, GridRule rule, double k, double sigma1);
 // M = floor(L / (factor · h_min)) segments, at least 2. Throws std::invalid_argument if factor < 1
 // or the string is too short for two segments.
-int gridSegments(const StringPhysics& physics, GridRule rule, double k, double sigma1, double factor);
+int gridSegments(const StringPhysics& physics, GridRule rule, double k, double sigma1,
+                 double factor);
 
 }  // namespace hamiltone

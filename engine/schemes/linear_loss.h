@@ -28,7 +28,8 @@ template <HamiltonianSystem S>
 class LinearLoss {
  public:
   LinearLoss() = default;
-  LinearLoss(const S& system, const StepParameters& p) : sigma0_(p.sigma0), sigma1_(p.sigma1), k_(p.k) {
+  LinearLoss(const S& system, const StepParameters& p)
+      : sigma0_(p.sigma0), sigma1_(p.sigma1), k_(p.k) {
     if constexpr (!HasLossOperator<S>) {
       if (p.sigma1 != 0.0)
         throw std::invalid_argument("loss sigma1 = " + formatNumber(p.sigma1) +
@@ -54,8 +55,8 @@ class LinearLoss {
   double dissipation(const S& s, const Vector& qNext, const Vector& qPrev) noexcept {
     double d = 0.0;
     if (sigma0_ > 0.0)
-      d += sigma0_ / (2.0 * k_) *
-           ((qNext - qPrev).array().square() / s.inverseMass().array()).sum();
+      d +=
+          sigma0_ / (2.0 * k_) * ((qNext - qPrev).array().square() / s.inverseMass().array()).sum();
     if constexpr (HasLossOperator<S>) {
       if (sigma1_ > 0.0) {
         s.applyLossOperator(qNext, qPrev, diff_);
@@ -96,8 +97,8 @@ class LinearLoss {
 
  private:
   double sigma0_ = 0.0, sigma1_ = 0.0, k_ = 0.0;
-  Vector cq_;             // C (q^n − q^{n−1})
-  mutable Vector diff_;   // scratch of dissipation() and kineticCorrection()
+  Vector cq_;            // C (q^n − q^{n−1})
+  mutable Vector diff_;  // scratch of dissipation() and kineticCorrection()
 };
 
 // The largest k for which Ĥ of the split scheme (38) is non-negative: in M-normalised modes the

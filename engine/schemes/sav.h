@@ -112,8 +112,8 @@ class SavScheme {
     //   b = (2I − k²M⁻¹K) q^n − 2kψ α − ((1−σ0k) I − αβᵀ) q^{n−1} − 2σ1k M⁻¹C (q^n − q^{n−1}),
     // of which Sherman–Morrison (33) needs βᵀb, here assembled from the dot products above.
     const double twoKPsi = 2.0 * k * psi_;
-    const double gb = 2.0 * gq - twoKPsi * h * gMg - down * gqm + h * gMg * btqm - kk * gMKq -
-                      twoSigma1K * gMCq;
+    const double gb =
+        2.0 * gq - twoKPsi * h * gMg - down * gqm + h * gMg * btqm - kk * gMKq - twoSigma1K * gMCq;
     const double coef = h * gb / (up + bta);  // βᵀb / (1+σ0k + βᵀα)
 
     // (33) with A0 = (1+σ0k) I: q^{n+1} = (b − α coef) / (1+σ0k); α's multiples collected in c.
@@ -129,7 +129,7 @@ class SavScheme {
       qp[i] = x;
       gdq += gv[i] * (x - qm[i]);
     }
-    psi_ += 0.5 * s * gdq;  // (38c)
+    psi_ += 0.5 * s * gdq;                                                         // (38c)
     if constexpr (lossy) dissipated_ += loss_.dissipation(system_, next_, prev_);  // (50)
 
     prev_.swap(curr_);

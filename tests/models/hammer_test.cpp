@@ -100,8 +100,8 @@ struct BarrierStrike {
 // Starts 0.1 mm below the wall at speed v0 and interpolates the crossings of w = 0.
 BarrierStrike strike(const HammerFelt& felt, double v0, double k) {
   HammerOnBarrier system{Hammer(felt)};
-  SplitSav<HammerOnBarrier> scheme(system, {.k = k},
-                                   {Vector::Constant(1, -1e-4), Vector::Constant(1, felt.mass * v0)});
+  SplitSav<HammerOnBarrier> scheme(
+      system, {.k = k}, {Vector::Constant(1, -1e-4), Vector::Constant(1, felt.mass * v0)});
   const double h0 = scheme.energy().total();
   double enter = NAN, leave = NAN;
   for (int n = 0; n < 1000000 && std::isnan(leave); ++n) {
@@ -208,8 +208,8 @@ TEST(HammeredString, FrequencyDependentLossTightensTheBound) {
   EXPECT_THROW(SplitSav<HammeredString>(tooFine, {.k = k, .sigma1 = 0.1}, rest),
                std::invalid_argument);
   const HammeredString fits(NonlinearString(physics, lossy), HammerFelt{});
-  EXPECT_NO_THROW(SplitSav<HammeredString>(
-      fits, {.k = k, .sigma1 = 0.1}, {Vector::Zero(fits.size()), Vector::Zero(fits.size())}));
+  EXPECT_NO_THROW(SplitSav<HammeredString>(fits, {.k = k, .sigma1 = 0.1},
+                                           {Vector::Zero(fits.size()), Vector::Zero(fits.size())}));
 }
 
 }  // namespace

@@ -2,9 +2,9 @@
 // and the bound (44) rely on, the loss operator is −ρA h D2, and unphysical strings are refused.
 #include "models/string.h"
 
-#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -92,8 +92,10 @@ TEST(NonlinearString, StiffnessHasTheClosedFormSpectrum) {
   }
   std::sort(expected.begin(), expected.end());
   for (size_t i = 0; i < expected.size(); ++i)
-    EXPECT_NEAR(eig.eigenvalues()[static_cast<Eigen::Index>(i)], expected[i], 1e-9 * expected.back());
-  EXPECT_NEAR(eig.eigenvalues().maxCoeff(), string.stiffnessEigenvalueMax(), 1e-9 * expected.back());
+    EXPECT_NEAR(eig.eigenvalues()[static_cast<Eigen::Index>(i)], expected[i],
+                1e-9 * expected.back());
+  EXPECT_NEAR(eig.eigenvalues().maxCoeff(), string.stiffnessEigenvalueMax(),
+              1e-9 * expected.back());
 }
 
 TEST(NonlinearString, LossOperatorIsMinusRhoAhD2OfTheDifference) {
@@ -102,9 +104,8 @@ TEST(NonlinearString, LossOperatorIsMinusRhoAhD2OfTheDifference) {
   const Vector a = randomState(n, 1.0, 7), b = randomState(n, 1.0, 8);
   Vector out(n);
   string.applyLossOperator(a, b, out);
-  const Eigen::MatrixXd c = matrixOf(string, [&](const Vector& x, Vector& y) {
-    string.applyLossOperator(x, Vector::Zero(n), y);
-  });
+  const Eigen::MatrixXd c = matrixOf(
+      string, [&](const Vector& x, Vector& y) { string.applyLossOperator(x, Vector::Zero(n), y); });
   EXPECT_LE((c * (a - b) - out).cwiseAbs().maxCoeff(), 1e-12 * out.cwiseAbs().maxCoeff());
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(c * string.inverseMass()[0]);
   EXPECT_GE(eig.eigenvalues().minCoeff(), 0.0);
