@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "schemes/hamiltonian.h"
+#include "usage_error.h"
 
 namespace hamiltone::cli {
 
@@ -24,9 +25,10 @@ struct RunSummary {
 // Full double precision: 17 significant digits round-trip.
 inline void writeNumber(std::FILE* out, double x) { std::fprintf(out, ",%.17g", x); }
 
-// Writes rows n = 0, every, 2·every, … <= steps; `columns(scheme, out)` writes the state part
-// of a row. The balance energy + dissipated is what (50) keeps constant, so its drift is the
-// deviation reported, lossy or not. Stops at the first non-finite state, after writing it.
+// Writes rows n = 0, every, 2·every, … <= steps: the time, then `columns(scheme, energy, out)`,
+// which writes the rest of the row with writeNumber. The balance energy + dissipated is what
+// (50) keeps constant, so its drift is the deviation reported, lossy or not. Stops at the first
+// non-finite state, after writing it.
 template <class Scheme, class Columns>
 RunSummary runToCsv(Scheme& scheme, long steps, long every, std::FILE* out, Columns columns) {
   RunSummary summary;
@@ -38,10 +40,7 @@ RunSummary runToCsv(Scheme& scheme, long steps, long every, std::FILE* out, Colu
     const bool finite = std::isfinite(balance) && scheme.q().allFinite();
     if (n % every == 0 || !finite) {
       std::fprintf(out, "%.17g", scheme.time());
-      columns(scheme, out);
-      writeNumber(out, e.total());
-      writeNumber(out, e.kinetic);
-      writeNumber(out, e.potential);
+      columns(scheme, e, out);
       std::fputc('\n', out);
       ++summary.rows;
     }
@@ -60,5 +59,22 @@ RunSummary runToCsv(Scheme& scheme, long steps, long every, std::FILE* out, Colu
   summary.dissipated = scheme.dissipated();
   return summary;
 }
+
+// Engine errors about parameters are usage errors of the flags that set them.
+template <class Make>
+auto building(Make make) {
+  try {
+    return make();
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+}
+
+// floor(duration / k) steps, refused outside 1 … 1e10.
+long stepCount(double duration, double k);
+
+// The lines a run prints on stdout (and its divergence warning on stderr).
+void printSummary(const std::string& command, const std::string& what, const std::string& path,
+                  const RunSummary& summary);
 
 }  // namespace hamiltone::cli

@@ -75,19 +75,13 @@ RunSummary simulate(Scheme scheme, const FpuRun& run, std::FILE* out) {
   for (Eigen::Index i = 1; i <= run.chain.size(); ++i)
     std::fprintf(out, ",q%ld", static_cast<long>(i));
   std::fprintf(out, ",energy,kinetic,potential\n");
-  return runToCsv(scheme, run.steps, run.every, out, [](const Scheme& s, std::FILE* f) {
-    for (double x : s.q()) writeNumber(f, x);
-  });
-}
-
-// Engine errors about parameters are usage errors of the flags that set them.
-template <class Make>
-auto building(Make make) {
-  try {
-    return make();
-  } catch (const std::invalid_argument& e) {
-    throw UsageError(e.what());
-  }
+  return runToCsv(scheme, run.steps, run.every, out,
+                  [](const Scheme& s, const Energy& e, std::FILE* f) {
+                    for (double x : s.q()) writeNumber(f, x);
+                    writeNumber(f, e.total());
+                    writeNumber(f, e.kinetic);
+                    writeNumber(f, e.potential);
+                  });
 }
 
 }  // namespace
@@ -97,7 +91,7 @@ int runFpuCommand(const FpuArguments& a) {
   const double duration = parseReal("--duration", a.duration, Range::positive, "seconds");
   const double alpha = parseReal("--alpha", a.alpha, Range::any);
   const double omega = parseReal("--omega", a.omega, Range::positive, "rad/s");
-  const long pairs = parseInteger("--pairs", a.pairs, 2);
+  const long pairs = parseInteger("--pairs", a.pairs, 2, 1'000'000);
   const double epsilon = parseReal("--epsilon", a.epsilon, Range::nonNegative, "J");
   const double sigma0 = parseReal("--sigma0", a.sigma0, Range::nonNegative, "1/s");
   const long every = parseInteger("--every", a.every, 1);
@@ -109,16 +103,12 @@ int runFpuCommand(const FpuArguments& a) {
   if (sigma0 != 0.0 && a.scheme == "marazzato")
     throw UsageError("--sigma0 = " + a.sigma0 +
                      ": marazzato is lossless; use sv, sav or sav-split");
-  const double stepsReal = std::floor(duration / k * (1.0 + 1e-12));
-  if (stepsReal < 1.0 || stepsReal > 1e10)
-    throw UsageError("--duration / --k = " + std::to_string(duration / k) +
-                     " steps: expected between 1 and 1e10");
-  if (pairs > 1'000'000) throw UsageError("--pairs = " + a.pairs + ": expected at most 1000000");
+  const long steps = stepCount(duration, k);
 
   FpuRun run{building([&] { return FermiPastaUlam(static_cast<int>(pairs), omega); }),
              {},
              {.k = k, .sigma0 = sigma0, .epsilon = epsilon},
-             static_cast<long>(stepsReal),
+             steps,
              every};
   run.start = building([&] { return fpuInitialState(run.chain, alpha); });
 
@@ -143,20 +133,8 @@ int runFpuCommand(const FpuArguments& a) {
   }
   file.commit();
 
-  std::printf("fpu: %s, %ld pairs, k = %g s, %ld steps; wrote %s (%ld rows)\n", a.scheme.c_str(),
-              pairs, k, summary.steps, a.out.c_str(), summary.rows);
-  std::printf("energy at t = 0: %.17g; ", summary.initialEnergy);
-  if (summary.initialEnergy != 0.0)
-    std::printf("max relative energy drift (51): %.3g", summary.maxRelativeDeviation);
-  else
-    std::printf("no energy to drift (alpha = 0)");
-  if (sigma0 > 0.0) std::printf(" (energy + dissipated %.6g)", summary.dissipated);
-  std::printf("\n");
-  if (summary.diverged)
-    std::fprintf(stderr,
-                 "hamiltone-sim fpu: warning: the state became non-finite at t = %.17g; the run "
-                 "stopped there (%s is unstable at this k and amplitude)\n",
-                 summary.divergedAt, a.scheme.c_str());
+  printSummary("fpu", a.scheme + ", " + std::to_string(pairs) + " pairs, k = " + a.k + " s", a.out,
+               summary);
   return 0;
 }
 

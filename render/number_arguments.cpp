@@ -35,14 +35,16 @@ double parseReal(const std::string& flag, const std::string& text, Range range,
   return x;
 }
 
-long parseInteger(const std::string& flag, const std::string& text, long minimum) {
-  const std::string valid = "expected a whole number >= " + std::to_string(minimum);
+long parseInteger(const std::string& flag, const std::string& text, long minimum, long maximum) {
+  const std::string valid =
+      "expected a whole number from " + std::to_string(minimum) + " to " + std::to_string(maximum);
   char* end = nullptr;
   errno = 0;
   const long x = std::strtol(text.c_str(), &end, 10);
   if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE)
     throw UsageError(flag + " = '" + text + "': not a whole number; " + valid);
-  if (x < minimum) throw UsageError(flag + " = " + text + ": out of range; " + valid);
+  if (x < minimum || x > maximum)
+    throw UsageError(flag + " = " + text + ": out of range; " + valid);
   return x;
 }
 

@@ -6,6 +6,7 @@
 #include <exception>
 
 #include "fpu_command.h"
+#include "string_command.h"
 #include "usage_error.h"
 
 int main(int argc, char** argv) {
@@ -16,6 +17,8 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   FpuArguments fpu;
   CLI::App* fpuCommand = addFpuCommand(app, fpu);
+  StringArguments string;
+  CLI::App* stringCommand = addStringCommand(app, string);
 
   try {
     app.parse(argc, argv);
@@ -30,6 +33,7 @@ int main(int argc, char** argv) {
 
   try {
     if (fpuCommand->parsed()) return runFpuCommand(fpu);
+    if (stringCommand->parsed()) return runStringCommand(string);
   } catch (const UsageError& e) {
     std::fprintf(stderr, "hamiltone-sim %s: %s\n",
                  app.get_subcommands().front()->get_name().c_str(), e.what());

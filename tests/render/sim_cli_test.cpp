@@ -161,4 +161,49 @@ TEST_F(SimCli, LeavesAnExistingFileAloneOnError) {
   EXPECT_EQ(slurp(csv()), "keep\n");
 }
 
+TEST_F(SimCli, StringWritesTheDocumentedCsv) {
+  const Result r = run("string --duration 1e-3 --every 500 --out " + csv());
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  std::istringstream text(slurp(csv()));
+  std::string comment;
+  std::getline(text, comment);
+  EXPECT_EQ(comment.rfind("# segments=909 h=0.00138503850385", 0), 0u) << comment;
+  std::string rest((std::istreambuf_iterator<char>(text)), std::istreambuf_iterator<char>());
+  std::string header;
+  const auto rows = parseRows(rest, header);
+  EXPECT_EQ(header, "t,u,v,energy,psi");
+  ASSERT_EQ(rows.size(), 8u);  // 3846 steps, every 500
+  // (70) at the probe x = L/2 (grid point 454 of 909: x = 0.4994 L), α = 300.
+  EXPECT_NEAR(rows[0][1], 300.0 * std::sqrt(8.87e-7) * std::sin(M_PI * 454.0 / 909.0), 1e-15);
+  for (const auto& row : rows) {
+    ASSERT_EQ(row.size(), 5u);
+    EXPECT_NEAR(row[3], rows[0][3], 1e-10 * rows[0][3]);  // (41) conserved
+  }
+}
+
+TEST_F(SimCli, StringStrikeWithTheHammer) {
+  const Result r =
+      run("string --grid transverse --k 2.0833333333e-5 --stiffness on --alpha 0 "
+          "--hammer-velocity 3 --duration 0.05 --out " +
+          csv());
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.out.find("energy at t = 0: 0.042525"), std::string::npos) << r.out;  // ½ M_H v²
+}
+
+TEST_F(SimCli, StringRefusesBadInput) {
+  const std::string ok = "string --duration 1e-5 --out " + csv();
+  expectRefused(ok + " --probe 1", "--probe");
+  expectRefused(ok + " --grid-factor 0.5", "--grid-factor");
+  expectRefused(ok + " --grid diagonal", "--grid");
+  expectRefused(ok + " --stiffness maybe", "--stiffness");
+  expectRefused(ok + " --tension 2e5", "tension");
+  expectRefused(ok + " --rho -1", "--rho");
+  expectRefused(ok + " --hammer-velocity 3", "--hammer-velocity");
+  expectRefused(ok + " --scheme sv --epsilon 1", "--epsilon");
+  expectRefused(ok + " --segments 1", "--segments");
+  expectRefused(ok + " --segments 100000 --k 1e-5", "(44)");
+  expectRefused(ok + " --length 1e-4", "length");
+  expectRefused("string --out " + (dir_ / "no" / "x.csv").string(), "--out");
+}
+
 }  // namespace

@@ -1,0 +1,35 @@
+// The step count and the summary every hamiltone-sim subcommand prints.
+#include "csv_run.h"
+
+#include <cmath>
+
+namespace hamiltone::cli {
+
+long stepCount(double duration, double k) {
+  const double steps = std::floor(duration / k * (1.0 + 1e-12));
+  if (!(steps >= 1.0) || steps > 1e10)
+    throw UsageError("--duration / --k = " + std::to_string(duration / k) +
+                     " steps: expected between 1 and 1e10");
+  return static_cast<long>(steps);
+}
+
+void printSummary(const std::string& command, const std::string& what, const std::string& path,
+                  const RunSummary& summary) {
+  std::printf("%s: %s, %ld steps; wrote %s (%ld rows)\n", command.c_str(), what.c_str(),
+              summary.steps, path.c_str(), summary.rows);
+  std::printf("energy at t = 0: %.17g J; ", summary.initialEnergy);
+  if (summary.initialEnergy != 0.0)
+    std::printf("max relative energy drift (51): %.3g", summary.maxRelativeDeviation);
+  else
+    std::printf("no energy to drift");
+  if (summary.dissipated > 0.0)
+    std::printf(" of energy + dissipated; dissipated %.6g J", summary.dissipated);
+  std::printf("\n");
+  if (summary.diverged)
+    std::fprintf(stderr,
+                 "hamiltone-sim %s: warning: the state became non-finite at t = %.17g; the run "
+                 "stopped there (the scheme is unstable at this k and amplitude)\n",
+                 command.c_str(), summary.divergedAt);
+}
+
+}  // namespace hamiltone::cli

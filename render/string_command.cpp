@@ -1,0 +1,165 @@
+// Parses the string subcommand, builds the string (and hammer) on the chosen grid and writes CSV.
+#include "string_command.h"
+
+#include <CLI/Validators.hpp>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+
+#include "atomic_file.h"
+#include "csv_run.h"
+#include "models/hammer.h"
+#include "models/string.h"
+#include "number_arguments.h"
+#include "schemes/sav.h"
+#include "schemes/stormer_verlet.h"
+
+namespace hamiltone::cli {
+
+CLI::App* addStringCommand(CLI::App& app, StringArguments& a) {
+  CLI::App* cmd = app.add_subcommand(
+      "string",
+      "Geometrically exact string (BDZ (56), split (65)), transverse u and longitudinal v, fixed "
+      "ends. Start (70): u = α sqrt(A) sin(πx/L), v = 0, at rest; or --alpha 0 "
+      "--hammer-velocity V: struck by a felt hammer (C3 law) at 0.12 L.");
+  cmd->add_option("--scheme", a.scheme, "sv: Störmer–Verlet (66); sav-split: split scheme (38)")
+      ->check(CLI::IsMember({"sv", "sav-split"}))
+      ->capture_default_str();
+  cmd->add_option("--grid", a.grid,
+                  "longitudinal: h >= sqrt(E/ρ) k (the paper's); transverse: the finest grid the "
+                  "stiff-string bound (44) allows")
+      ->check(CLI::IsMember({"longitudinal", "transverse"}))
+      ->capture_default_str();
+  cmd->add_option("--stiffness", a.stiffness, "bending stiffness EI, I = πr⁴/4 of the section")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
+  // Numbers are taken as text and parsed strictly by runStringCommand.
+  auto number = [&](const char* flag, std::string& value, const char* type, const char* what) {
+    cmd->add_option(flag, value, what)->type_name(type)->capture_default_str();
+  };
+  number("--k", a.k, "SECONDS", "time step (> 0)");
+  number("--grid-factor", a.gridFactor, "NUMBER", "multiplies the rule's minimal h (>= 1)");
+  cmd->add_option("--segments", a.segments,
+                  "number of grid segments M, instead of the grid rule (a fixed grid for "
+                  "convergence in k)")
+      ->type_name("INT");
+  number("--alpha", a.alpha, "NUMBER", "amplitude of the first-mode start (70)");
+  number("--hammer-velocity", a.hammerVelocity, "M/S", "hammer speed at impact; needs --alpha 0");
+  number("--epsilon", a.epsilon, "JOULES", "gauge shift ε of sav-split, §2.5 (>= 0)");
+  number("--duration", a.duration, "SECONDS", "simulated time (> 0)");
+  number("--probe", a.probe, "FRACTION", "where u, v are written, as a fraction of L (0..1)");
+  number("--every", a.every, "INT", "write every N-th step (>= 1); n = 0 is always written");
+  number("--rho", a.density, "KG/M3", "density ρ (> 0)");
+  number("--area", a.area, "M2", "cross-section A (> 0)");
+  number("--length", a.length, "M", "length L (> 0)");
+  number("--young", a.young, "PA", "Young's modulus E (> 0; E A > T0)");
+  number("--tension", a.tension, "N", "tension T0 (> 0)");
+  number("--sigma0", a.sigma0, "1/S", "frequency-independent loss σ0 (>= 0)");
+  number("--sigma1", a.sigma1, "M2/S", "frequency-dependent loss σ1 (>= 0)");
+  cmd->add_option("--out", a.out, "CSV file to write (replaced whole, or left untouched on error)")
+      ->type_name("PATH")
+      ->required();
+  cmd->footer(
+      "CSV: a comment line '# segments=M h=... k=...', a header, then one row per written step\n"
+      "  n: t,u,v,energy,psi. t = n k; u, v = u^n, v^n at the grid point nearest probe·L;\n"
+      "  energy = H^{n+1/2} of (41) (sv: (41) with ψ = 0 plus V'(u^n, v^n)), with the gauge\n"
+      "  shift ε excluded; psi = ψ^{n+1/2} (0 for sv). With loss, energy + dissipated is\n"
+      "  what stays constant.\n"
+      "Exit codes: 0 done (a scheme that diverges stops early, with a warning), 2 bad input.");
+  return cmd;
+}
+
+namespace {
+
+template <class Scheme>
+RunSummary simulate(Scheme scheme, Eigen::Index probe, long steps, long every, std::FILE* out) {
+  const Eigen::Index longitudinal = scheme.system().size() / 2;  // u then v (then the hammer)
+  std::fprintf(out, "t,u,v,energy,psi\n");
+  return runToCsv(scheme, steps, every, out, [&](const Scheme& s, const Energy& e, std::FILE* f) {
+    writeNumber(f, s.q()[probe]);
+    writeNumber(f, s.q()[probe + longitudinal]);
+    writeNumber(f, e.total());
+    if constexpr (requires { s.psi(); })
+      writeNumber(f, s.psi());
+    else
+      writeNumber(f, 0.0);
+  });
+}
+
+template <class System>
+RunSummary run(const std::string& scheme, const System& system, const InitialState& start,
+               const StepParameters& params, Eigen::Index probe, long steps, long every,
+               std::FILE* out) {
+  if (scheme == "sv")
+    return simulate(building([&] { return StormerVerlet<System>(system, params, start); }), probe,
+                    steps, every, out);
+  return simulate(building([&] { return SplitSav<System>(system, params, start); }), probe, steps,
+                  every, out);
+}
+
+}  // namespace
+
+int runStringCommand(const StringArguments& a) {
+  StringPhysics physics;
+  physics.density = parseReal("--rho", a.density, Range::positive, "kg/m^3");
+  physics.area = parseReal("--area", a.area, Range::positive, "m^2");
+  physics.length = parseReal("--length", a.length, Range::positive, "m");
+  physics.young = parseReal("--young", a.young, Range::positive, "Pa");
+  physics.tension = parseReal("--tension", a.tension, Range::positive, "N");
+  if (a.stiffness == "on") physics.inertia = physics.area * physics.area / (4.0 * std::numbers::pi);
+  const double k = parseReal("--k", a.k, Range::positive, "seconds");
+  const double factor = parseReal("--grid-factor", a.gridFactor, Range::positive);
+  if (factor < 1.0)
+    throw UsageError("--grid-factor = " + a.gridFactor + ": out of range; expected >= 1");
+  const double alpha = parseReal("--alpha", a.alpha, Range::any);
+  const double hammerVelocity =
+      parseReal("--hammer-velocity", a.hammerVelocity, Range::nonNegative, "m/s");
+  const double epsilon = parseReal("--epsilon", a.epsilon, Range::nonNegative, "J");
+  const double duration = parseReal("--duration", a.duration, Range::positive, "seconds");
+  const double probe = parseReal("--probe", a.probe, Range::positive);
+  if (probe >= 1.0) throw UsageError("--probe = " + a.probe + ": out of range; expected in (0, 1)");
+  const long every = parseInteger("--every", a.every, 1);
+  const double sigma0 = parseReal("--sigma0", a.sigma0, Range::nonNegative, "1/s");
+  const double sigma1 = parseReal("--sigma1", a.sigma1, Range::nonNegative, "m^2/s");
+  if (hammerVelocity > 0.0 && alpha != 0.0)
+    throw UsageError("--hammer-velocity = " + a.hammerVelocity +
+                     ": a strike starts from rest; give --alpha 0 with it");
+  if (epsilon != 0.0 && a.scheme == "sv")
+    throw UsageError("--epsilon = " + a.epsilon + ": the gauge shift applies to sav-split only");
+  const long steps = stepCount(duration, k);
+
+  const GridRule rule = a.grid == "transverse" ? GridRule::transverse : GridRule::longitudinal;
+  const int segments =
+      a.segments.empty() ? building([&] { return gridSegments(physics, rule, k, sigma1, factor); })
+                         : static_cast<int>(parseInteger("--segments", a.segments, 2, 1'000'000));
+  const NonlinearString string = building([&] { return NonlinearString(physics, segments); });
+  const Eigen::Index probeIndex =
+      std::clamp<Eigen::Index>(std::lround(probe * segments) - 1, 0, segments - 2);
+  const StepParameters params{.k = k, .sigma0 = sigma0, .sigma1 = sigma1, .epsilon = epsilon};
+
+  AtomicFile file(a.out, "--out");
+  std::fprintf(file.stream(), "# segments=%d h=%.17g k=%.17g\n", segments, string.spacing(), k);
+  RunSummary summary;
+  const Eigen::Index n = string.size();
+  if (hammerVelocity > 0.0) {
+    const HammerFelt felt;
+    const HammeredString system = building([&] { return HammeredString(string, felt); });
+    InitialState start{Vector::Zero(n + 1), Vector::Zero(n + 1)};
+    start.q[n] = -1e-4;  // 0.1 mm below the string
+    start.p[n] = felt.mass * hammerVelocity;
+    summary = run(a.scheme, system, start, params, probeIndex, steps, every, file.stream());
+  } else {
+    InitialState start{Vector::Zero(n), Vector::Zero(n)};
+    for (int j = 0; j < segments - 1; ++j)  // (70)
+      start.q[j] = alpha * std::sqrt(physics.area) *
+                   std::sin(std::numbers::pi * (j + 1) / static_cast<double>(segments));
+    summary = run(a.scheme, string, start, params, probeIndex, steps, every, file.stream());
+  }
+  file.commit();
+  printSummary("string",
+               a.scheme + ", " + std::to_string(segments) + " segments, k = " + a.k + " s", a.out,
+               summary);
+  return 0;
+}
+
+}  // namespace hamiltone::cli
