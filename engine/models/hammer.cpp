@@ -106,6 +106,23 @@ double HammeredString::splitGradient(const Vector& q, Vector& grad) const {
   return v + (eta > 0.0 ? f * eta / (hammer_.felt().exponent + 1.0) : 0.0);  // Φ = Φ'(η) η/(p+1)
 }
 
+double HammeredString::partPotential(int part, const Vector& q) const {
+  return part == 0 ? string_.splitPotential(q) : hammer_.potential(compression(q));
+}
+
+double HammeredString::partGradient(int part, const Vector& q, Vector& grad) const {
+  if (part == 0) {
+    grad[hammerIndex()] = 0.0;
+    return string_.splitGradient(q, grad);
+  }
+  const double eta = compression(q);
+  const double f = hammer_.force(eta);
+  grad.setZero();
+  grad[hammerIndex()] = f;
+  for (size_t i = 0; i < contactIndex_.size(); ++i) grad[contactIndex_[i]] = -contactWeight_[i] * f;
+  return eta > 0.0 ? f * eta / (hammer_.felt().exponent + 1.0) : 0.0;
+}
+
 void HammeredString::applyLossOperator(const Vector& a, const Vector& b, Vector& out) const {
   string_.applyLossOperator(a, b, out);
   out[hammerIndex()] = 0.0;

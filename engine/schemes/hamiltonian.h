@@ -22,6 +22,17 @@ concept HamiltonianSystem = requires(const S& s, const Vector& q, Vector& out) {
   { s.splitGradient(q, out) } -> std::convertible_to<double>;     // out = ∇V'(q); returns V'(q)
 };
 
+// A model whose V' is a sum V' = Σ_j V'_j of parts quadratised separately, each with its own
+// auxiliary variable ψ_j (SCHEMES §3: one SAV per nonlinearity, rank-P Woodbury update), so that
+// the error of one part's ψ does not leak into the others' forces. splitPotential and
+// splitGradient still give the sum.
+template <class S>
+concept PartitionedPotential = requires(const S& s, const Vector& q, Vector& out, int j) {
+  { S::potentialParts } -> std::convertible_to<int>;
+  { s.partPotential(j, q) } -> std::convertible_to<double>;
+  { s.partGradient(j, q, out) } -> std::convertible_to<double>;  // out = ∇V'_j; returns V'_j
+};
+
 // The full potential V = ½ qᵀKq + V' of (16), for the schemes that do not split it.
 // `scratch` receives K q.
 template <HamiltonianSystem S>

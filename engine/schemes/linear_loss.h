@@ -40,6 +40,7 @@ class LinearLoss {
   }
 
   bool any() const { return sigma0_ > 0.0 || sigma1_ > 0.0; }
+  void setSigma0(double sigma0) noexcept { sigma0_ = sigma0; }
   double sigma0() const { return sigma0_; }
   double sigma1() const { return sigma1_; }
 

@@ -1,6 +1,8 @@
 // BDZ's explicit exactly energy-conserving SAV schemes: non-split (27), split-potential (38).
 #pragma once
 
+#include <Eigen/Dense>
+#include <array>
 #include <cmath>
 #include <utility>
 
@@ -19,9 +21,18 @@ enum class SavForm { nonSplit, split };
 // The reported potential excludes the gauge shift ε: ½ψ² − ε ≈ V'(q^{n+½}).
 // Loss (linear_loss.h): σ0 centred as in (49), so the left matrix (1+σ0k) I + αβᵀ is still
 // inverted by Sherman–Morrison; σ1 explicit. The balance (50) holds exactly (dissipated()).
+// A PartitionedPotential gets one ψ_j per part (split form only): the left matrix is
+// (1+σ0k) I + Σ_j α_j β_jᵀ, inverted by Woodbury with a P×P solve; the energy has Σ_j ½ψ_j².
 template <HamiltonianSystem S, SavForm form>
 class SavScheme {
   static constexpr bool splitK = form == SavForm::split && S::hasStiffness;
+  static constexpr bool partitioned = form == SavForm::split && PartitionedPotential<S>;
+  static constexpr int parts = [] {
+    if constexpr (partitioned) return S::potentialParts;
+    return 1;
+  }();
+  using Small = Eigen::Matrix<double, parts, parts>;
+  using SmallVector = Eigen::Matrix<double, parts, 1>;
 
  public:
   SavScheme(S system, const StepParameters& params, const InitialState& start)
@@ -30,14 +41,16 @@ class SavScheme {
     const Eigen::Index n = system_.size();
     checkInitialState(start, n);
     if constexpr (splitK) checkStabilityBound();
-    for (Vector* v : {&prev_, &curr_, &next_, &grad_, &kq_}) v->setZero(n);
+    for (Vector* v : {&prev_, &curr_, &next_, &kq_}) v->setZero(n);
+    for (Vector& g : grads_) g.setZero(n);
     // (21); leaves K q^0 in kq_.
     prev_ = start.q;
-    fullGradient(system_, prev_, grad_, kq_);
-    loss_.taylorStart(system_, start, grad_, curr_);
+    fullGradient(system_, prev_, grads_[0], kq_);
+    loss_.taylorStart(system_, start, grads_[0], curr_);
     // ψ^{½} = sqrt(2 (V'(q^{½}) + ε)) with q^{½} = (q^0 + q^1)/2: second order, like (32).
     next_ = 0.5 * (prev_ + curr_);
-    psi_ = std::sqrt(2.0 * (quadratisedPotential(next_) + params_.epsilon));
+    for (int j = 0; j < parts; ++j)
+      psi_[j] = std::sqrt(2.0 * (quadratisedPotential(j, next_) + params_.epsilon));
   }
 
   // One step of (38) [(27) when nonSplit]: q^{n+1} from q^n, q^{n−1}, ψ^{n−½} by (40) and
@@ -56,16 +69,40 @@ class SavScheme {
     Energy e;
     e.kinetic = intervalKineticEnergy(system_.inverseMass(), prev_, curr_, params_.k) +
                 loss_.kineticCorrection(system_, prev_, curr_);
-    e.potential = 0.5 * psi_ * psi_ - params_.epsilon;
+    e.potential = 0.0;
+    for (double psi : psi_) e.potential += 0.5 * psi * psi - params_.epsilon;
     if constexpr (splitK) e.potential += 0.5 * curr_.dot(kq_);
     return e;
+  }
+
+  // Changes σ0 between steps, e.g. a damper falling on the string: any σ0 >= 0 with σ0 k < 1 keeps
+  // the bound (44), which depends on σ1 only. The balance (50) goes on with the new value.
+  void setSigma0(double sigma0) noexcept {
+    params_.sigma0 = sigma0;
+    loss_.setSigma0(sigma0);
+  }
+
+  // Sets coordinate i at levels n and n+1 — a hammer placed and launched, or caught. The caller
+  // keeps V' unchanged by it (the coordinate out of contact), so ψ stays consistent; the energy
+  // changes by the kinetic energy given or taken, which energy() then reports.
+  void setCoordinate(Eigen::Index i, double qn, double qNext) noexcept {
+    prev_[i] = qn;
+    curr_[i] = qNext;
+  }
+
+  // Sets ψ_j^{n+½} back to sqrt(2 (V'_j(q^{n+½}) + ε)), q^{n+½} = (q^n + q^{n+1})/2, dropping
+  // the O(k²) residual ψ_j keeps once its part goes slack (a hammer after the strike). The
+  // energy changes by what the residual held, which energy() then reports.
+  void resetPsi(int part) noexcept {
+    next_ = 0.5 * (prev_ + curr_);  // next_ is workspace between steps
+    psi_[part] = std::sqrt(2.0 * (quadratisedPotential(part, next_) + params_.epsilon));
   }
 
   long stepIndex() const { return n_; }
   double time() const { return static_cast<double>(n_) * params_.k; }
   const Vector& q() const { return prev_; }
   const Vector& qNext() const { return curr_; }
-  double psi() const { return psi_; }  // ψ^{n+½}
+  double psi(int part = 0) const { return psi_[part]; }  // ψ_j^{n+½}
   // Energy taken by the loss since the start: energy().total() + dissipated() is constant (50).
   double dissipated() const { return dissipated_; }
   const S& system() const { return system_; }
@@ -86,50 +123,100 @@ class SavScheme {
     const double* qm = prev_.data();
     const double* q = curr_.data();
     double* qp = next_.data();
-    const double* gv = grad_.data();
     const double* kq = kq_.data();
 
-    // (39): g = ∇V' / sqrt(2 (V' + ε)), g = 0 where V' + ε = 0. grad_ holds ∇V', g = s ∇V'.
-    const double shifted = gradient() + params_.epsilon;
-    const double s = shifted > 0.0 ? 1.0 / std::sqrt(2.0 * shifted) : 0.0;
-    const double h = 0.5 * k * s;  // α = h M⁻¹∇V',  β = h ∇V'   (31)
-
+    // (39): g_j = ∇V'_j / sqrt(2 (V'_j + ε)), g_j = 0 where V'_j + ε = 0; grads_ hold ∇V'_j, so
+    // g_j = s_j ∇V'_j, and α_j = h_j M⁻¹∇V'_j, β_j = h_j ∇V'_j   (31).
+    std::array<const double*, parts> g;
+    double s[parts], h[parts];
+    for (int j = 0; j < parts; ++j) {
+      const double shifted = gradient(j) + params_.epsilon;
+      s[j] = shifted > 0.0 ? 1.0 / std::sqrt(2.0 * shifted) : 0.0;
+      h[j] = 0.5 * k * s[j];
+      g[j] = grads_[j].data();
+    }
     const double twoSigma1K = 2.0 * params_.sigma1 * k;
     const double* cq = lossy ? loss_.frequencyForce(system_, curr_, prev_).data() : nullptr;
 
-    double gq = 0.0, gqm = 0.0, gMg = 0.0, gMKq = 0.0, gMCq = 0.0;
-#pragma omp simd reduction(+ : gq, gqm, gMg, gMKq, gMCq)
-    for (Eigen::Index i = 0; i < n; ++i) {
-      gq += gv[i] * q[i];
-      gqm += gv[i] * qm[i];
-      gMg += gv[i] * minv[i] * gv[i];
-      if constexpr (splitK) gMKq += gv[i] * (minv[i] * kq[i]);
-      if constexpr (lossy) gMCq += gv[i] * (minv[i] * cq[i]);
+    // Pass 1: ∇V'_jᵀ of q^n, q^{n−1}, M⁻¹K q^n, M⁻¹C(q^n − q^{n−1}), and ∇V'_iᵀ M⁻¹ ∇V'_j.
+    // With one part the sums are scalars, which GCC keeps in registers; array reductions cost
+    // it a third more on the 1000-pair FPU chain.
+    double gq[parts] = {}, gqm[parts] = {}, gMKq[parts] = {}, gMCq[parts] = {};
+    double gMg[parts * parts] = {};
+    if constexpr (parts == 1) {
+      const double* g0 = g[0];
+      double sq = 0.0, sqm = 0.0, sMKq = 0.0, sMCq = 0.0, sMg = 0.0;
+#pragma omp simd reduction(+ : sq, sqm, sMKq, sMCq, sMg)
+      for (Eigen::Index i = 0; i < n; ++i) {
+        sq += g0[i] * q[i];
+        sqm += g0[i] * qm[i];
+        if constexpr (splitK) sMKq += g0[i] * (minv[i] * kq[i]);
+        if constexpr (lossy) sMCq += g0[i] * (minv[i] * cq[i]);
+        sMg += g0[i] * minv[i] * g0[i];
+      }
+      gq[0] = sq, gqm[0] = sqm, gMKq[0] = sMKq, gMCq[0] = sMCq, gMg[0] = sMg;
+    } else {
+#pragma omp simd reduction(+ : gq[:parts], gqm[:parts], gMKq[:parts], gMCq[:parts], \
+                               gMg[:parts * parts])
+      for (Eigen::Index i = 0; i < n; ++i) {
+        for (int a = 0; a < parts; ++a) {
+          const double ga = g[a][i];
+          gq[a] += ga * q[i];
+          gqm[a] += ga * qm[i];
+          if constexpr (splitK) gMKq[a] += ga * (minv[i] * kq[i]);
+          if constexpr (lossy) gMCq[a] += ga * (minv[i] * cq[i]);
+          for (int b = a; b < parts; ++b) gMg[a * parts + b] += ga * minv[i] * g[b][i];
+        }
+      }
     }
-    const double btqm = h * gqm;     // βᵀ q^{n−1}
-    const double bta = h * h * gMg;  // βᵀ α
     // (40) with the loss (49) and the σ1 term:
-    //   b = (2I − k²M⁻¹K) q^n − 2kψ α − ((1−σ0k) I − αβᵀ) q^{n−1} − 2σ1k M⁻¹C (q^n − q^{n−1}),
-    // of which Sherman–Morrison (33) needs βᵀb, here assembled from the dot products above.
-    const double twoKPsi = 2.0 * k * psi_;
-    const double gb =
-        2.0 * gq - twoKPsi * h * gMg - down * gqm + h * gMg * btqm - kk * gMKq - twoSigma1K * gMCq;
-    const double coef = h * gb / (up + bta);  // βᵀb / (1+σ0k + βᵀα)
+    //   b = (2I − k²M⁻¹K) q^n − 2k Σ ψ_j α_j − ((1−σ0k) I − Σ α_j β_jᵀ) q^{n−1}
+    //       − 2σ1k M⁻¹C (q^n − q^{n−1}),
+    // of which Woodbury needs Vᵀb = (β_iᵀ b)_i, assembled from the dot products above.
+    // (33) generalised: q^{n+1} = (b − U y) / (1+σ0k), y = ((1+σ0k) I + VᵀU)⁻¹ Vᵀb,
+    // U = [α_j], V = [β_j].
+    Small vtu;
+    SmallVector vtb, bLinear;  // bLinear_j: the weight of α_j in b
+    for (int a = 0; a < parts; ++a) {
+      bLinear[a] = h[a] * gqm[a] - 2.0 * k * psi_[a];  // β_jᵀ q^{n−1} − 2kψ_j
+      for (int b = a; b < parts; ++b) vtu(a, b) = vtu(b, a) = h[a] * h[b] * gMg[a * parts + b];
+    }
+    for (int a = 0; a < parts; ++a) {
+      double gb = 2.0 * gq[a] - down * gqm[a] - kk * gMKq[a] - twoSigma1K * gMCq[a];
+      for (int b = 0; b < parts; ++b)
+        gb += bLinear[b] * h[b] * gMg[std::min(a, b) * parts + std::max(a, b)];
+      vtb[a] = h[a] * gb;
+    }
+    const SmallVector y = (Small::Identity() * up + vtu).inverse() * vtb;
+    double c[parts];  // the weights of M⁻¹∇V'_j in q^{n+1} (1+σ0k)
+    for (int a = 0; a < parts; ++a) c[a] = h[a] * (bLinear[a] - y[a]);
 
-    // (33) with A0 = (1+σ0k) I: q^{n+1} = (b − α coef) / (1+σ0k); α's multiples collected in c.
-    const double c = h * (btqm - twoKPsi - coef);
+    // Pass 2: q^{n+1}, and ∇V'_jᵀ (q^{n+1} − q^{n−1}) for (38c).
     const double invUp = 1.0 / up;
-    double gdq = 0.0;
-#pragma omp simd reduction(+ : gdq)
-    for (Eigen::Index i = 0; i < n; ++i) {
+    auto newPosition = [&](Eigen::Index i, double correction) {
       double b = 2.0 * q[i] - down * qm[i];
       if constexpr (splitK) b -= kk * (minv[i] * kq[i]);
       if constexpr (lossy) b -= twoSigma1K * (minv[i] * cq[i]);
-      const double x = (b + c * (minv[i] * gv[i])) * invUp;
-      qp[i] = x;
-      gdq += gv[i] * (x - qm[i]);
+      return qp[i] = (b + correction) * invUp;
+    };
+    double gdq[parts] = {};
+    if constexpr (parts == 1) {
+      const double* g0 = g[0];
+      double sdq = 0.0;
+#pragma omp simd reduction(+ : sdq)
+      for (Eigen::Index i = 0; i < n; ++i)
+        sdq += g0[i] * (newPosition(i, c[0] * (minv[i] * g0[i])) - qm[i]);
+      gdq[0] = sdq;
+    } else {
+#pragma omp simd reduction(+ : gdq[:parts])
+      for (Eigen::Index i = 0; i < n; ++i) {
+        double correction = 0.0;
+        for (int a = 0; a < parts; ++a) correction += c[a] * (minv[i] * g[a][i]);
+        const double x = newPosition(i, correction);
+        for (int a = 0; a < parts; ++a) gdq[a] += g[a][i] * (x - qm[i]);
+      }
     }
-    psi_ += 0.5 * s * gdq;                                                         // (38c)
+    for (int a = 0; a < parts; ++a) psi_[a] += 0.5 * s[a] * gdq[a];                // (38c)
     if constexpr (lossy) dissipated_ += loss_.dissipation(system_, next_, prev_);  // (50)
 
     prev_.swap(curr_);
@@ -153,25 +240,31 @@ class SavScheme {
           " breaks the stability bound (44) of the split scheme: k <= " + formatNumber(kMax));
   }
 
-  // The potential that ψ quadratises: V' for (38), the whole V for (27).
-  double quadratisedPotential(const Vector& q) {
+  // The potential that ψ_j quadratises: V'_j (or all of V') for (38), the whole V for (27).
+  double quadratisedPotential(int part, const Vector& q) {
+    if constexpr (partitioned) return system_.partPotential(part, q);
     if constexpr (form == SavForm::split) return system_.splitPotential(q);
     return fullPotential(system_, q, kq_);
   }
 
-  // Its gradient at q^n into grad_ (and K q^n into kq_ where K is taken linearly); returns it.
-  double gradient() noexcept {
-    if constexpr (form == SavForm::nonSplit) return fullGradient(system_, curr_, grad_, kq_);
-    if constexpr (splitK) system_.applyStiffness(curr_, kq_);
-    return system_.splitGradient(curr_, grad_);
+  // Its gradient at q^n into grads_[part] (and K q^n into kq_ where K is taken linearly, with
+  // part 0); returns the potential.
+  double gradient(int part) noexcept {
+    if constexpr (form == SavForm::nonSplit) return fullGradient(system_, curr_, grads_[0], kq_);
+    if constexpr (splitK) {
+      if (part == 0) system_.applyStiffness(curr_, kq_);
+    }
+    if constexpr (partitioned) return system_.partGradient(part, curr_, grads_[part]);
+    return system_.splitGradient(curr_, grads_[0]);
   }
 
   S system_;
   StepParameters params_;
   LinearLoss<S> loss_;
-  Vector prev_, curr_, next_;  // q^n, q^{n+1}, workspace; rotated by swapping
-  Vector grad_, kq_;           // ∇V' (∇V) and K q at the newest level a step used
-  double psi_ = 0.0;           // ψ^{n+½}
+  Vector prev_, curr_, next_;        // q^n, q^{n+1}, workspace; rotated by swapping
+  std::array<Vector, parts> grads_;  // ∇V'_j (∇V for (27)) at the newest level a step used
+  Vector kq_;                        // and K q there
+  std::array<double, parts> psi_{};  // ψ_j^{n+½}
   double dissipated_ = 0.0;
   long n_ = 0;
 };

@@ -1,29 +1,66 @@
 // No scheme allocates while stepping or reporting energy: Eigen's EIGEN_RUNTIME_NO_MALLOC guard,
-// armed in this binary (see tests/CMakeLists.txt), aborts on any heap allocation through Eigen.
+// armed in this binary (see tests/CMakeLists.txt), aborts on any heap allocation through Eigen,
+// and this binary's operator new counts every other allocation made while it is forbidden.
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <cstdlib>
+#include <new>
 #include <numbers>
+#include <vector>
 
 #include "models/hammer.h"
+#include "presets/piano_scale.h"
 #include "support/fpu_runs.h"
+#include "voices/string_voice.h"
+
+namespace {
+std::atomic<bool> forbidden{false};
+std::atomic<long> forbiddenNews{0};
+}  // namespace
+
+void* operator new(std::size_t size) {
+  if (forbidden) ++forbiddenNews;
+  if (void* p = std::malloc(size ? size : 1)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 
 namespace hamiltone {
 namespace {
 
+// Both guards on: Eigen's (aborts) and operator new's (counted).
+void forbidAllocation(bool forbid) {
+  Eigen::internal::set_is_malloc_allowed(!forbid);
+  forbidden = forbid;
+}
+
 template <class Scheme>
 void stepWithoutAllocating(Scheme& scheme) {
   double sink = 0.0;
-  Eigen::internal::set_is_malloc_allowed(false);
+  const long before = forbiddenNews;
+  forbidAllocation(true);
   for (int n = 0; n < 1000; ++n) {
     scheme.step();
     sink += scheme.energy().total() + scheme.dissipated();
   }
-  Eigen::internal::set_is_malloc_allowed(true);
+  forbidAllocation(false);
+  EXPECT_EQ(forbiddenNews - before, 0);
   EXPECT_TRUE(std::isfinite(sink));
 }
 
 FermiPastaUlam chain() { return FermiPastaUlam(50, 50.0); }
 InitialState start() { return fpuInitialState(chain(), 10.0); }
+
+TEST(NoAllocation, OperatorNewGuardCounts) {
+  const long before = forbiddenNews;
+  forbidAllocation(true);
+  auto* p = new std::vector<int>(10);
+  forbidAllocation(false);
+  delete p;
+  EXPECT_EQ(forbiddenNews - before, 2);  // the vector and its buffer
+}
 
 TEST(NoAllocation, GuardIsArmed) {
   EXPECT_DEATH(
@@ -72,15 +109,38 @@ TEST(NoAllocation, SchemesOnTheStruckString) {
                           [](auto&&... a) { return StormerVerlet<HammeredString>(a...); });
 }
 
+// The voice's audio path: strike, steps, hammer catch, pickups, decimation, guard, damper.
+TEST(NoAllocation, StringVoiceProcess) {
+  for (int oversampling : {1, 4}) {
+    StringPatch patch;
+    patch.string = pianoString(60);
+    patch.oversampling = oversampling;
+    StringVoice voice;
+    voice.prepare(patch, 60, 48000.0);
+    std::vector<float> left(256), right(256);
+    const long before = forbiddenNews;
+    forbidAllocation(true);
+    voice.noteOn(0.8);
+    for (int block = 0; block < 100; ++block) {
+      if (block == 50) voice.release();
+      voice.process(left, right);
+    }
+    voice.reset();
+    forbidAllocation(false);
+    EXPECT_EQ(forbiddenNews - before, 0);
+    EXPECT_EQ(voice.guardEvents(), 0);
+  }
+}
+
 TEST(NoAllocation, MarazzatoWithEveryQuadrature) {
   for (QuadratureRule rule :
        {QuadratureRule::midpoint, QuadratureRule::gaussLegendre2, QuadratureRule::gaussLegendre3,
         QuadratureRule::gaussLegendre5, QuadratureRule::lobatto3, QuadratureRule::lobatto5}) {
     Marazzato<FermiPastaUlam> s(chain(), {.k = 1e-3}, start(), rule);
     stepWithoutAllocating(s);
-    Eigen::internal::set_is_malloc_allowed(false);
+    forbidAllocation(true);
     const double d = s.discreteEnergy();
-    Eigen::internal::set_is_malloc_allowed(true);
+    forbidAllocation(false);
     EXPECT_GT(d, 0.0);
   }
 }

@@ -1,0 +1,215 @@
+// The string voice's setup (tuning, losses, grid), its strike, damper and hammer check, and the
+// audio loop: R scheme steps per output sample, pickups, decimation, and the guard.
+#include "voices/string_voice.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+#include "presets/piano_scale.h"
+#include "util/format_number.h"
+
+namespace hamiltone {
+
+namespace {
+
+constexpr double kLn1000 = 6.907755278982137;  // T60 = ln(1000) / σ
+constexpr double kStrikeGap = 1e-4;            // m: the hammer starts 0.1 mm below the string
+constexpr double kParkedAt = -0.02;            // m: where the back-check holds it
+constexpr double kCheckDelay = 1e-3;           // s out of contact, moving away, before the catch
+
+void require(bool ok, const char* field, double value, const std::string& valid) {
+  if (!ok)
+    throw std::invalid_argument(std::string(field) + " = " + formatNumber(value) + ": must be " +
+                                valid);
+}
+
+// ξ with c² ξ + κ² ξ² = ω²: the wavenumber² of a partial of angular frequency ω.
+double wavenumberSquared(const StringPhysics& p, double omega) {
+  const double c2 = p.tension / p.linearDensity();
+  const double kappa2 = p.young * p.inertia / p.linearDensity();
+  if (kappa2 == 0.0) return omega * omega / c2;
+  return (-c2 + std::sqrt(c2 * c2 + 4.0 * kappa2 * omega * omega)) / (2.0 * kappa2);
+}
+
+}  // namespace
+
+StringLoss stringLossFromT60(const StringPhysics& string, double t60Low, double t60High,
+                             double highHz) {
+  require(t60Low > 0.0, "t60_low_s", t60Low, "> 0 seconds (inf for no loss)");
+  require(
+      t60High > 0.0 && t60High <= t60Low, "t60_high_s", t60High,
+      "> 0 and at most t60_low_s = " + formatNumber(t60Low) + " (higher partials decay faster)");
+  require(std::isfinite(highHz) && highHz > 0.0, "t60_high_hz", highHz, "a frequency > 0 Hz");
+  StringLoss loss;
+  loss.sigma0 = std::isfinite(t60Low) ? kLn1000 / t60Low : 0.0;
+  const double high = std::isfinite(t60High) ? kLn1000 / t60High : 0.0;
+  loss.sigma1 = (high - loss.sigma0) / wavenumberSquared(string, 2.0 * std::numbers::pi * highHz);
+  return loss;
+}
+
+void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleRate) {
+  const int r = patch.oversampling;
+  require(r == 1 || r == 2 || r == 4 || r == 8 || r == 16, "oversampling", r, "1, 2, 4, 8 or 16");
+  require(std::isfinite(sampleRate) && sampleRate >= 8000.0 && sampleRate <= 384000.0,
+          "sample rate", sampleRate, "between 8000 and 384000 Hz");
+  require(std::isfinite(patch.a4Hz) && patch.a4Hz >= 400.0 && patch.a4Hz <= 480.0, "a4_hz",
+          patch.a4Hz, "between 400 and 480 Hz");
+  require(std::isfinite(patch.damperT60) && patch.damperT60 > 0.0, "damper_t60_s", patch.damperT60,
+          "a finite time > 0 seconds");
+  for (double p : patch.pickups)
+    require(p > 0.0 && p < 1.0, "pickup_position", p, "a fraction of the length in (0, 1)");
+  require(patch.channels == 1 || patch.channels == 2, "channels", patch.channels, "1 or 2");
+  require(std::isfinite(patch.gain), "gain", patch.gain, "a finite number");
+  require(patch.velocityMin >= 0.0 && patch.velocityMax >= patch.velocityMin &&
+              patch.velocityMax <= 20.0,
+          "hammer_velocity_max_m_s", patch.velocityMax,
+          "at least hammer_velocity_min_m_s and at most 20 m/s");
+  require(std::isfinite(patch.velocityCurve) && patch.velocityCurve > 0.0, "velocity_curve",
+          patch.velocityCurve, "a number > 0");
+  require(patch.guardEnergyMultiple > 1.0, "guard_energy_multiple", patch.guardEnergyMultiple,
+          "a number > 1");
+  require(std::isfinite(patch.epsilon) && patch.epsilon >= 0.0, "epsilon_j", patch.epsilon,
+          "a finite number >= 0 J");
+
+  patch_ = patch;
+  sampleRate_ = sampleRate;
+  k_ = 1.0 / (sampleRate * r);
+  const double target = equalTemperament(midiNote, patch.a4Hz);
+  // The loss sets the grid (its σ1 tightens (44)) and the tuning sets the loss (ξ depends on T0):
+  // two rounds settle both, σ1 being a small correction.
+  TunedString tuned{patch.string, 0};
+  for (int round = 0; round < 2; ++round) {
+    loss_ = stringLossFromT60(tuned.physics, patch.t60Low, patch.t60High, patch.t60HighHz);
+    tuned = tuneString(patch.string, patch.tuneBy, patch.grid, k_, loss_.sigma1, patch.gridFactor,
+                       target);
+  }
+  const HammeredString system(NonlinearString(tuned.physics, tuned.segments), patch.hammer);
+  InitialState rest{Vector::Zero(system.size()), Vector::Zero(system.size())};
+  rest.q[system.hammerIndex()] = kParkedAt;
+  const StepParameters params{
+      .k = k_, .sigma0 = loss_.sigma0, .sigma1 = loss_.sigma1, .epsilon = patch.epsilon};
+  scheme_ = std::make_unique<SplitSav<HammeredString>>(system, params, rest);
+  atRest_ = std::make_unique<SplitSav<HammeredString>>(*scheme_);
+  fundamental_ = schemePartial(system.string(), k_, 1);
+  for (Decimator& d : decimators_) d.prepare(r);
+  reset();
+}
+
+void StringVoice::reset() noexcept {
+  *scheme_ = *atRest_;  // same sizes: copies without allocating
+  for (Decimator& d : decimators_) d.reset();
+  injected_ = caught_ = 0.0;
+  separatedSteps_ = 0;
+  quietTime_ = 0.0;
+  active_ = released_ = struck_ = false;
+}
+
+int StringVoice::segments() const { return scheme_->system().string().segments(); }
+
+double StringVoice::energy() const { return scheme_->energy().total(); }
+
+double StringVoice::dissipatedEnergy() const { return scheme_->dissipated() + caught_; }
+
+void StringVoice::noteOn(double velocity) noexcept {
+  const double v = velocity >= 0.0 ? std::min(velocity, 1.0) : 0.0;  // NaN too
+  const double speed = patch_.velocityMin + (patch_.velocityMax - patch_.velocityMin) *
+                                                std::pow(v, patch_.velocityCurve);
+  const HammeredString& system = scheme_->system();
+  const Eigen::Index w = system.hammerIndex();
+  const double before = energy();
+  // Out of contact, the hammer is placed just below the string and launched; in contact (a very
+  // fast repeat) it is only given the new speed where it is.
+  const double start = system.compression(scheme_->q()) > 0.0
+                           ? scheme_->q()[w]
+                           : system.contactDisplacement(scheme_->q()) - kStrikeGap;
+  scheme_->setCoordinate(w, start, start + speed * k_);
+  injected_ += energy() - before;
+  scheme_->setSigma0(loss_.sigma0);
+  separatedSteps_ = 0;
+  struck_ = false;
+  released_ = false;
+  active_ = true;
+}
+
+void StringVoice::release() noexcept {
+  released_ = true;
+  scheme_->setSigma0(loss_.sigma0 + kLn1000 / patch_.damperT60);
+}
+
+// The back-check: once the hammer has struck and left the string (escapement: no force drives
+// it back), it is caught and parked out of reach. Its kinetic energy leaves the system, and so
+// does what the felt's ψ kept of the strike (its SAV residual); both are counted.
+void StringVoice::catchHammer() noexcept {
+  const HammeredString& system = scheme_->system();
+  const Eigen::Index w = system.hammerIndex();
+  const Vector& q = scheme_->q();
+  if (q[w] == kParkedAt && scheme_->qNext()[w] == kParkedAt) return;
+  if (system.compression(q) > 0.0) {
+    struck_ = true;
+    separatedSteps_ = 0;
+    return;
+  }
+  if (!struck_ || ++separatedSteps_ * k_ < kCheckDelay) return;
+  const double before = energy();
+  scheme_->setCoordinate(w, kParkedAt, kParkedAt);
+  scheme_->resetPsi(1);
+  caught_ += before - energy();
+}
+
+double StringVoice::pickup(const Vector& q, const Vector& qNext, double position) const {
+  const int m = segments();
+  const double s = std::clamp(position * m - 1.0, 0.0, m - 2.0);  // grid index, x = (j + 1) h
+  const int j = std::min(static_cast<int>(s), m - 2);
+  const double f = s - j;
+  const int j1 = std::min(j + 1, m - 2);
+  auto at = [&](const Vector& x) { return (1.0 - f) * x[j] + f * x[j1]; };
+  if (patch_.signal == PickupSignal::displacement) return at(q);
+  return (at(qNext) - at(q)) / k_;
+}
+
+void StringVoice::process(std::span<float> left, std::span<float> right) noexcept {
+  const bool stereo = patch_.channels == 2 && right.size() >= left.size();
+  if (!active_) {
+    std::fill(left.begin(), left.end(), 0.0f);
+    if (stereo) std::fill(right.begin(), right.begin() + left.size(), 0.0f);
+    return;
+  }
+  bool finite = true;
+  for (size_t i = 0; i < left.size(); ++i) {
+    double out[2] = {0.0, 0.0};
+    bool ready = false;
+    while (!ready) {
+      scheme_->step();
+      catchHammer();
+      const Vector& q = scheme_->q();
+      const Vector& qNext = scheme_->qNext();
+      for (int c = 0; c < patch_.channels; ++c)
+        ready = decimators_[c].push(pickup(q, qNext, patch_.pickups[c]), out[c]);
+    }
+    left[i] = static_cast<float>(patch_.gain * out[0]);
+    if (stereo) right[i] = static_cast<float>(patch_.gain * out[1]);
+    finite = finite && std::isfinite(left[i]) && (!stereo || std::isfinite(right[i]));
+  }
+  // The guard: a non-finite sample or runaway energy never leaves the voice.
+  const Energy e = scheme_->energy();
+  const double h = e.total();
+  if (!finite || !std::isfinite(h) || h > patch_.guardEnergyMultiple * injected_) {
+    std::fill(left.begin(), left.end(), 0.0f);
+    if (stereo) std::fill(right.begin(), right.begin() + left.size(), 0.0f);
+    ++guardEvents_;
+    reset();
+    return;
+  }
+  // Released and silent — its kinetic energy 120 dB under the strike's for 50 ms, longer than
+  // the lowest string's half period — the voice is free. Kinetic, not total: on the transverse
+  // grid the SAV can leave a static longitudinal stretch that holds potential but sounds nothing.
+  quietTime_ = released_ && e.kinetic < 1e-12 * injected_
+                   ? quietTime_ + static_cast<double>(left.size()) / sampleRate_
+                   : 0.0;
+  if (quietTime_ > 0.05) active_ = false;
+}
+
+}  // namespace hamiltone

@@ -1,0 +1,86 @@
+// A piano string voice: the struck string (HammeredString) on the split scheme (38), tuned to its
+// note, oversampled and decimated to the audio rate, with damper, pickups and a guard.
+#pragma once
+
+#include <memory>
+#include <span>
+
+#include "models/hammer.h"
+#include "models/string_tuning.h"
+#include "schemes/sav.h"
+#include "voices/decimator.h"
+
+namespace hamiltone {
+
+enum class PickupSignal { velocity, displacement };
+
+// The sound: everything a preset sets for one string voice.
+struct StringPatch {
+  StringPhysics string;  // before tuning; the tuned quantity is replaced
+  HammerFelt hammer;
+  TuneBy tuneBy = TuneBy::tension;
+  double a4Hz = 440.0;
+  GridRule grid = GridRule::transverse;
+  double gridFactor = 1.0;
+  int oversampling = 1;  // 1, 2, 4, 8 or 16
+  double epsilon = 0.0;  // gauge shift, J
+  double t60Low = 20.0;  // s, decay time at 0 Hz (infinite: no loss)
+  double t60High = 4.0;  // s, decay time at t60HighHz
+  double t60HighHz = 2000.0;
+  double damperT60 = 0.25;           // s, decay time once released
+  double pickups[2] = {0.31, 0.73};  // fractions of L
+  int channels = 2;                  // 1: mono from pickups[0]; 2: one pickup per channel
+  PickupSignal signal = PickupSignal::velocity;
+  double gain = 0.25;  // output units per m/s (or per m)
+  double velocityMin = 0.5, velocityMax = 6.0,
+         velocityCurve = 1.0;        // m/s = min + (max−min)·v^curve
+  double guardEnergyMultiple = 4.0;  // silence when H exceeds this multiple of the injected energy
+};
+
+// σ(ξ) = σ0 + σ1 ξ is the decay rate of a mode of wavenumber² ξ; two T60s fix it (data §3.4):
+// σ0 = 6.908 / T60(0 Hz), σ1 = (6.908 / T60(f) − σ0) / ξ(f), ξ(ω) from c²ξ + κ²ξ² = ω².
+struct StringLoss {
+  double sigma0 = 0.0;
+  double sigma1 = 0.0;
+};
+StringLoss stringLossFromT60(const StringPhysics& string, double t60Low, double t60High,
+                             double highHz);
+
+class StringVoice {
+ public:
+  // May allocate; throws std::invalid_argument naming the patch field for an invalid patch.
+  void prepare(const StringPatch& patch, int midiNote, double sampleRate);
+  void reset() noexcept;  // the string at rest, the hammer parked, the damper up
+
+  void noteOn(double velocity) noexcept;  // velocity 0 … 1
+  void release() noexcept;                // the damper falls
+
+  // Writes (not adds) the next samples; right is ignored for a mono patch. Never allocates.
+  void process(std::span<float> left, std::span<float> right) noexcept;
+
+  bool active() const { return active_; }
+  double energy() const;  // the scheme's H^{n+½} (ε excluded), J
+  double injectedEnergy() const { return injected_; }
+  double dissipatedEnergy() const;  // by loss, damper and the caught hammer
+  int guardEvents() const { return guardEvents_; }
+  double fundamentalHz() const { return fundamental_; }
+  int segments() const;
+  const SplitSav<HammeredString>& scheme() const { return *scheme_; }
+
+ private:
+  double pickup(const Vector& q, const Vector& qNext, double position) const;
+  void catchHammer() noexcept;
+
+  StringPatch patch_;
+  std::unique_ptr<SplitSav<HammeredString>> scheme_;
+  std::unique_ptr<SplitSav<HammeredString>> atRest_;  // the reset state, copied in reset()
+  Decimator decimators_[2];
+  StringLoss loss_;
+  double sampleRate_ = 0.0, k_ = 0.0, fundamental_ = 0.0;
+  double injected_ = 0.0, caught_ = 0.0, quietTime_ = 0.0;
+  int guardEvents_ = 0;
+  int separatedSteps_ = 0;
+  bool active_ = false, released_ = false, struck_ = false;
+};
+
+}  // namespace hamiltone

@@ -1,0 +1,189 @@
+// The piano string voice: exact energy through strikes and the hammer's catch, decay times as the
+// patch asks (and the damper's), the guard, and finite output at the keyboard's extremes.
+#include "voices/string_voice.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "presets/piano_scale.h"
+#include "support/modal.h"
+
+namespace hamiltone {
+namespace {
+
+StringPatch piano(int note) {
+  StringPatch p;
+  p.string = pianoString(note);
+  return p;
+}
+
+StringPatch lossless(int note) {
+  StringPatch p = piano(note);
+  p.t60Low = p.t60High = INFINITY;
+  return p;
+}
+
+// Runs the voice for `seconds` in blocks; returns false if any sample was not finite.
+bool play(StringVoice& voice, double seconds, double rate, auto each) {
+  std::vector<float> l(64), r(64);
+  bool finite = true;
+  for (long n = 0; n < std::lround(seconds * rate / 64); ++n) {
+    voice.process(l, r);
+    for (size_t i = 0; i < l.size(); ++i)
+      finite = finite && std::isfinite(l[i]) && std::isfinite(r[i]);
+    each();
+  }
+  return finite;
+}
+
+// Lossless, every strike's energy stays: H + the caught hammer's energy = the injected energy,
+// over 2 s at 48 kHz (~1e5 steps; roundoff ~1e-16 per step per unknown, far below 1e-10).
+TEST(StringVoice, StrikesConserveEnergyExactly) {
+  for (int velocity : {1, 64, 127}) {
+    StringVoice voice;
+    voice.prepare(lossless(48), 48, 48000.0);
+    voice.noteOn(velocity / 127.0);
+    const double injected = voice.injectedEnergy();
+    const double hammer = 0.5 * HammerFelt{}.mass;
+    const double speed = 0.5 + 5.5 * velocity / 127.0;
+    EXPECT_NEAR(injected, hammer * speed * speed, 1e-9 * injected);
+    double worst = 0.0;
+    EXPECT_TRUE(play(voice, 2.0, 48000.0, [&] {
+      worst = std::max(worst,
+                       std::abs(voice.energy() + voice.dissipatedEnergy() - injected) / injected);
+    }));
+    EXPECT_LE(worst, 1e-10) << "velocity " << velocity;
+    EXPECT_GT(voice.dissipatedEnergy(), 0.0);  // the hammer was caught with some energy left
+    EXPECT_EQ(voice.guardEvents(), 0);
+  }
+}
+
+// Mode-1 energy ½(ȧ² + ω² a²) of the string decays as e^{−2σt}; its slope gives the T60.
+double measuredT60(StringVoice& voice, double from, double to) {
+  const double k = voice.scheme().parameters().k;
+  const double omega = 2.0 * std::numbers::pi * voice.fundamentalHz();
+  const int m = voice.segments();
+  std::vector<double> t, logE;
+  double time = 0.0;
+  play(voice, to, 48000.0, [&] {
+    time += 64.0 / 48000.0;
+    const double a = testing::modalAmplitude(voice.scheme().q(), m, 1);
+    const double rate = (testing::modalAmplitude(voice.scheme().qNext(), m, 1) - a) / k;
+    if (time >= from) {
+      t.push_back(time);
+      logE.push_back(std::log(rate * rate + omega * omega * a * a));
+    }
+  });
+  double st = 0, se = 0, stt = 0, ste = 0;
+  const double n = static_cast<double>(t.size());
+  for (size_t i = 0; i < t.size(); ++i) {
+    st += t[i];
+    se += logE[i];
+    stt += t[i] * t[i];
+    ste += t[i] * logE[i];
+  }
+  const double slope = (n * ste - st * se) / (n * stt - st * st);
+  return 2.0 * 6.907755278982137 / -slope;
+}
+
+TEST(StringVoice, FundamentalDecaysInThePatchT60) {
+  StringPatch patch = piano(48);
+  patch.t60Low = 3.0;
+  patch.t60High = 1.0;
+  patch.t60HighHz = 2000.0;
+  StringVoice voice;
+  voice.prepare(patch, 48, 48000.0);
+  voice.noteOn(0.5);
+  // The law σ0 + σ1 ξ at the fundamental's ξ = (π/L)²: the expected T60 of mode 1.
+  const StringLoss loss =
+      stringLossFromT60(voice.scheme().system().string().physics(), 3.0, 1.0, 2000.0);
+  const double length = voice.scheme().system().string().physics().length;
+  const double expected =
+      6.907755278982137 / (loss.sigma0 + loss.sigma1 * std::pow(std::numbers::pi / length, 2));
+  EXPECT_NEAR(measuredT60(voice, 0.2, 1.5), expected, 0.05 * expected);
+}
+
+TEST(StringVoice, DamperShortensTheDecayToItsT60) {
+  StringPatch patch = piano(48);
+  patch.t60Low = patch.t60High = INFINITY;
+  patch.damperT60 = 0.3;
+  StringVoice voice;
+  voice.prepare(patch, 48, 48000.0);
+  voice.noteOn(0.5);
+  play(voice, 0.05, 48000.0, [] {});
+  voice.release();
+  EXPECT_NEAR(measuredT60(voice, 0.0, 0.4), 0.3, 0.05 * 0.3);
+  play(voice, 3.0, 48000.0, [] {});  // 120 dB down and more: the voice frees itself
+  EXPECT_FALSE(voice.active());
+}
+
+// A gauge shift of 1e30 J drowns the energy (41) in roundoff (the ulp of 1e30 is ~1e14 J):
+// exactly the runaway the guard exists for. The output is silent and the voice reset.
+TEST(StringVoice, GuardSilencesARunawayVoiceAndCountsIt) {
+  StringPatch patch = piano(60);
+  patch.epsilon = 1e30;
+  StringVoice voice;
+  voice.prepare(patch, 60, 48000.0);
+  voice.noteOn(1.0);
+  std::vector<float> l(256, 1.0f), r(256, 1.0f);
+  int silent = 0;
+  for (int block = 0; block < 200 && voice.guardEvents() == 0; ++block) {
+    voice.process(l, r);
+    silent = 0;
+    for (float x : l) silent += x == 0.0f;
+  }
+  EXPECT_EQ(voice.guardEvents(), 1);
+  EXPECT_EQ(silent, 256);
+  EXPECT_FALSE(voice.active());
+}
+
+// The extremes: the lowest and highest keys at 44.1 and 192 kHz, struck at full speed with the
+// stiffest hammer of the plan (C8's, RT-425 law at key 88), lossless.
+TEST(StringVoice, KeyboardExtremesStayFiniteAndConserveEnergy) {
+  for (double rate : {44100.0, 192000.0}) {
+    for (int note : {21, 108}) {
+      StringPatch patch = lossless(note);
+      patch.hammer.mass = 5.71e-3;
+      patch.hammer.exponent = 3.541;
+      patch.hammer.stiffness = 2.066e12;
+      StringVoice voice;
+      voice.prepare(patch, note, rate);
+      voice.noteOn(1.0);
+      const double injected = voice.injectedEnergy();
+      double worst = 0.0;
+      EXPECT_TRUE(play(voice, 0.3, rate,
+                       [&] {
+                         worst = std::max(
+                             worst, std::abs(voice.energy() + voice.dissipatedEnergy() - injected) /
+                                        injected);
+                       }))
+          << note << " at " << rate;
+      EXPECT_LE(worst, 1e-10) << note << " at " << rate;
+      EXPECT_EQ(voice.guardEvents(), 0);
+    }
+  }
+}
+
+TEST(StringVoice, RefusesAnInvalidPatch) {
+  StringVoice voice;
+  auto with = [](auto change) {
+    StringPatch p = piano(60);
+    change(p);
+    return p;
+  };
+  EXPECT_THROW(voice.prepare(with([](auto& p) { p.oversampling = 3; }), 60, 48000),
+               std::invalid_argument);
+  EXPECT_THROW(voice.prepare(with([](auto& p) { p.t60High = 30.0; }), 60, 48000),
+               std::invalid_argument);
+  EXPECT_THROW(voice.prepare(with([](auto& p) { p.pickups[0] = 1.5; }), 60, 48000),
+               std::invalid_argument);
+  EXPECT_THROW(voice.prepare(with([](auto& p) { p.damperT60 = 0.0; }), 60, 48000),
+               std::invalid_argument);
+  EXPECT_THROW(voice.prepare(piano(60), 60, 1000.0), std::invalid_argument);
+  EXPECT_THROW(voice.prepare(piano(60), 130, 48000.0), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace hamiltone
