@@ -27,7 +27,8 @@ constexpr double kVelocity = 0.7;
 // the dissipation sums — so a lossless patch would time a cheaper voice than anyone hears. 0.5 s
 // is far inside the patch's shortest T60 (4 s at 2 kHz), so the string is loud at every strike and
 // the state never decays toward denormals; the few ms of felt contact per strike are timed too, as
-// in playing. One lossless, never re-struck C3 voice is timed beside it to show what the loss costs.
+// in playing. One lossless, never re-struck C3 voice is timed beside it to show what the loss
+// costs.
 constexpr int kRestrikeBlocks = static_cast<int>(0.5 * kSampleRate / kBlock);
 
 // An inverted rate is a time per item, shown as e.g. "1.2ns".
@@ -43,7 +44,9 @@ constexpr Note kNotes[] = {{21, "A0"}, {48, "C3"}, {84, "C6"}};
 constexpr GridRule kGrids[] = {GridRule::transverse, GridRule::longitudinal};
 constexpr int kOversampling[] = {1, 4};
 
-const char* gridName(GridRule g) { return g == GridRule::transverse ? "transverse" : "longitudinal"; }
+const char* gridName(GridRule g) {
+  return g == GridRule::transverse ? "transverse" : "longitudinal";
+}
 
 std::string voiceName(const Note& note, GridRule grid, int oversampling, bool lossless) {
   return std::string("StringVoice/") + note.name + "_" + std::to_string(note.midi) + "/" +
@@ -247,10 +250,10 @@ void printVoices(const RecordingReporter& reporter) {
     }
     const double nsPerSample = r->seconds / kBlock * 1e9;
     const double unknowns = r->counters.at("unknowns").value;
-    std::printf("%-4s %-12s %3d %-9s %8.0f %9.0f %10.1f %8.2f %16.3f\n", note.name,
-                gridName(grid), os, lossless ? "lossless" : "patch",
-                r->counters.at("segments").value, unknowns, nsPerSample,
-                100.0 * nsPerSample * kSampleRate / 1e9, nsPerSample / (os * unknowns));
+    std::printf("%-4s %-12s %3d %-9s %8.0f %9.0f %10.1f %8.2f %16.3f\n", note.name, gridName(grid),
+                os, lossless ? "lossless" : "patch", r->counters.at("segments").value, unknowns,
+                nsPerSample, 100.0 * nsPerSample * kSampleRate / 1e9,
+                nsPerSample / (os * unknowns));
   };
   for (const Note& note : kNotes)
     for (GridRule grid : kGrids)
@@ -259,8 +262,9 @@ void printVoices(const RecordingReporter& reporter) {
 
   if (const auto* r = reporter.find(voiceName(kNotes[1], GridRule::transverse, 1, false))) {
     const double perUnknown = r->seconds / kBlock * 1e9 / r->counters.at("unknowns").value;
-    std::printf("Goal: C3 voice, transverse grid, os 1, <= 2 ns per unknown per step: %.3f ns, %s\n",
-                perUnknown, verdict(perUnknown <= 2.0));
+    std::printf(
+        "Goal: C3 voice, transverse grid, os 1, <= 2 ns per unknown per step: %.3f ns, %s\n",
+        perUnknown, verdict(perUnknown <= 2.0));
   }
 }
 

@@ -8,8 +8,8 @@ namespace hamiltone::cli {
 
 class AtomicFile {
  public:
-  // Creates the temporary now, so an unwritable path fails before any work is done.
-  // Throws UsageError naming `flag` and the path.
+  // Creates the temporary now, so an unwritable path fails before any work is done. Throws
+  // UsageError naming `flag` and the path. SIGINT, SIGTERM and SIGHUP remove the temporary.
   AtomicFile(std::string path, const std::string& flag);
   ~AtomicFile();  // removes the temporary unless committed
   AtomicFile(const AtomicFile&) = delete;

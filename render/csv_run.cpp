@@ -13,6 +13,14 @@ long stepCount(double duration, double k) {
   return static_cast<long>(steps);
 }
 
+void checkOutputSize(long steps, long every, long columns) {
+  const double numbers = (static_cast<double>(steps / every) + 1.0) * static_cast<double>(columns);
+  if (numbers > 2e8)
+    throw UsageError("the CSV would hold " + std::to_string(static_cast<long long>(numbers)) +
+                     " numbers (" + std::to_string(static_cast<long long>(numbers * 2.4e-8)) +
+                     " GB): expected at most 2e8; raise --every or shorten --duration");
+}
+
 void printSummary(const std::string& command, const std::string& what, const std::string& path,
                   const RunSummary& summary) {
   std::printf("%s: %s, %ld steps; wrote %s (%ld rows)\n", command.c_str(), what.c_str(),
@@ -28,7 +36,7 @@ void printSummary(const std::string& command, const std::string& what, const std
   if (summary.diverged)
     std::fprintf(stderr,
                  "hamiltone-sim %s: warning: the state became non-finite at t = %.17g; the run "
-                 "stopped there (the scheme is unstable at this k and amplitude)\n",
+                 "stopped there, and the file ends with that row\n",
                  command.c_str(), summary.divergedAt);
 }
 

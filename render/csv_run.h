@@ -1,8 +1,11 @@
 // Steps a scheme and writes its rows as CSV: `t, <state columns>, energy, kinetic, potential`.
 #pragma once
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -28,12 +31,18 @@ inline void writeNumber(std::FILE* out, double x) { std::fprintf(out, ",%.17g", 
 // Writes rows n = 0, every, 2·every, … <= steps: the time, then `columns(scheme, energy, out)`,
 // which writes the rest of the row with writeNumber. The balance energy + dissipated is what
 // (50) keeps constant, so its drift is the deviation reported, lossy or not. Stops at the first
-// non-finite state, after writing it.
+// non-finite state, after writing it. A start whose energy is not finite is a usage error, with
+// `tooLarge` naming the arguments that can cause it; a failed write (a full disk) throws
+// std::runtime_error within a few thousand rows.
 template <class Scheme, class Columns>
-RunSummary runToCsv(Scheme& scheme, long steps, long every, std::FILE* out, Columns columns) {
+RunSummary runToCsv(Scheme& scheme, long steps, long every, std::FILE* out, Columns columns,
+                    const std::string& tooLarge) {
   RunSummary summary;
   summary.steps = steps;
   summary.initialEnergy = scheme.energy().total();
+  if (!std::isfinite(summary.initialEnergy))
+    throw UsageError("the start's energy is " + std::to_string(summary.initialEnergy) + ": " +
+                     tooLarge + " too large for double precision");
   for (long n = 0;; ++n) {
     const Energy e = scheme.energy();
     const double balance = e.total() + scheme.dissipated();
@@ -42,7 +51,8 @@ RunSummary runToCsv(Scheme& scheme, long steps, long every, std::FILE* out, Colu
       std::fprintf(out, "%.17g", scheme.time());
       columns(scheme, e, out);
       std::fputc('\n', out);
-      ++summary.rows;
+      if (++summary.rows % 4096 == 0 && std::ferror(out))
+        throw std::runtime_error("writing the output failed: " + std::string(std::strerror(errno)));
     }
     if (!finite) {
       summary.diverged = true;
@@ -72,6 +82,9 @@ auto building(Make make) {
 
 // floor(duration / k) steps, refused outside 1 … 1e10.
 long stepCount(double duration, double k);
+
+// Refuses a CSV of more than 2e8 numbers (a few GB): names --every and --duration.
+void checkOutputSize(long steps, long every, long columns);
 
 // The lines a run prints on stdout (and its divergence warning on stderr).
 void printSummary(const std::string& command, const std::string& what, const std::string& path,

@@ -55,7 +55,9 @@ CLI::App* addFpuCommand(CLI::App& app, FpuArguments& a) {
       "  potential = ½ q^{n+1}·K q^n + ½ψ² − ε (sv: ψ = 0 plus V'(q^n)). For marazzato it is\n"
       "  the pseudo-energy (13) at t^n: kinetic = ½ p^{n−½}·p^{n+½}, potential = V(q^n).\n"
       "  With loss, energy + dissipated energy is what stays constant (50).\n"
-      "Exit codes: 0 done (a scheme that diverges stops early, with a warning), 2 bad input.");
+      "Steps: floor(duration / k); the last row is at t = steps · k.\n"
+      "Exit codes: 0 done (a scheme that diverges stops early, with a warning), 1 an I/O error\n"
+      "  (a full disk; no file is left), 2 bad input, 128+N killed by signal N (no file left).");
   return fpu;
 }
 
@@ -75,13 +77,15 @@ RunSummary simulate(Scheme scheme, const FpuRun& run, std::FILE* out) {
   for (Eigen::Index i = 1; i <= run.chain.size(); ++i)
     std::fprintf(out, ",q%ld", static_cast<long>(i));
   std::fprintf(out, ",energy,kinetic,potential\n");
-  return runToCsv(scheme, run.steps, run.every, out,
-                  [](const Scheme& s, const Energy& e, std::FILE* f) {
-                    for (double x : s.q()) writeNumber(f, x);
-                    writeNumber(f, e.total());
-                    writeNumber(f, e.kinetic);
-                    writeNumber(f, e.potential);
-                  });
+  return runToCsv(
+      scheme, run.steps, run.every, out,
+      [](const Scheme& s, const Energy& e, std::FILE* f) {
+        for (double x : s.q()) writeNumber(f, x);
+        writeNumber(f, e.total());
+        writeNumber(f, e.kinetic);
+        writeNumber(f, e.potential);
+      },
+      "--alpha, --omega or --epsilon is");
 }
 
 }  // namespace
@@ -104,6 +108,7 @@ int runFpuCommand(const FpuArguments& a) {
     throw UsageError("--sigma0 = " + a.sigma0 +
                      ": marazzato is lossless; use sv, sav or sav-split");
   const long steps = stepCount(duration, k);
+  checkOutputSize(steps, every, 2 * pairs + 4);
 
   FpuRun run{building([&] { return FermiPastaUlam(static_cast<int>(pairs), omega); }),
              {},

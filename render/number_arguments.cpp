@@ -28,6 +28,8 @@ double parseReal(const std::string& flag, const std::string& text, Range range,
   const double x = std::strtod(text.c_str(), &end);
   if (text.empty() || end != text.c_str() + text.size())
     throw UsageError(flag + " = '" + text + "': not a number; " + valid);
+  if (errno == ERANGE && std::abs(x) < 1.0)
+    throw UsageError(flag + " = " + text + ": too small for double precision; " + valid);
   if (!std::isfinite(x) || errno == ERANGE)
     throw UsageError(flag + " = " + text + ": not finite; " + valid);
   if ((range == Range::positive && !(x > 0.0)) || (range == Range::nonNegative && x < 0.0))

@@ -65,7 +65,9 @@ CLI::App* addStringCommand(CLI::App& app, StringArguments& a) {
       "  energy = H^{n+1/2} of (41) (sv: (41) with ψ = 0 plus V'(u^n, v^n)), with the gauge\n"
       "  shift ε excluded; psi = ψ^{n+1/2} (0 for sv). With loss, energy + dissipated is\n"
       "  what stays constant.\n"
-      "Exit codes: 0 done (a scheme that diverges stops early, with a warning), 2 bad input.");
+      "Steps: floor(duration / k); the last row is at t = steps · k.\n"
+      "Exit codes: 0 done (a scheme that diverges stops early, with a warning), 1 an I/O error\n"
+      "  (a full disk; no file is left), 2 bad input, 128+N killed by signal N (no file left).");
   return cmd;
 }
 
@@ -75,15 +77,18 @@ template <class Scheme>
 RunSummary simulate(Scheme scheme, Eigen::Index probe, long steps, long every, std::FILE* out) {
   const Eigen::Index longitudinal = scheme.system().size() / 2;  // u then v (then the hammer)
   std::fprintf(out, "t,u,v,energy,psi\n");
-  return runToCsv(scheme, steps, every, out, [&](const Scheme& s, const Energy& e, std::FILE* f) {
-    writeNumber(f, s.q()[probe]);
-    writeNumber(f, s.q()[probe + longitudinal]);
-    writeNumber(f, e.total());
-    if constexpr (requires { s.psi(); })
-      writeNumber(f, s.psi());
-    else
-      writeNumber(f, 0.0);
-  });
+  return runToCsv(
+      scheme, steps, every, out,
+      [&](const Scheme& s, const Energy& e, std::FILE* f) {
+        writeNumber(f, s.q()[probe]);
+        writeNumber(f, s.q()[probe + longitudinal]);
+        writeNumber(f, e.total());
+        if constexpr (requires { s.psi(); })
+          writeNumber(f, s.psi());
+        else
+          writeNumber(f, 0.0);
+      },
+      "--alpha, --hammer-velocity or --epsilon is");
 }
 
 template <class System>
@@ -127,6 +132,7 @@ int runStringCommand(const StringArguments& a) {
   if (epsilon != 0.0 && a.scheme == "sv")
     throw UsageError("--epsilon = " + a.epsilon + ": the gauge shift applies to sav-split only");
   const long steps = stepCount(duration, k);
+  checkOutputSize(steps, every, 5);
 
   const GridRule rule = a.grid == "transverse" ? GridRule::transverse : GridRule::longitudinal;
   const int segments =

@@ -69,7 +69,8 @@ class Marazzato {
   long stepIndex() const { return n_; }
   double time() const { return static_cast<double>(n_) * params_.k; }
   const Vector& q() const { return q_; }
-  const Vector& p() const { return p_; }  // p^{n+½}
+  const Vector& p() const { return p_; }              // p^{n+½}
+  const Vector& pPrevious() const { return pPrev_; }  // p^{n−½}
   double dissipated() const { return 0.0; }
   const S& system() const { return system_; }
   const StepParameters& parameters() const { return params_; }

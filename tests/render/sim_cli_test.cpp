@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 
 #include <cmath>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -154,11 +155,65 @@ TEST_F(SimCli, RefusesAnUnwritableOutput) {
   expectRefused("fpu --scheme sav --out " + dir_.string(), "--out");
 }
 
+// The stability error comes after the output file was opened: the old file must survive it.
 TEST_F(SimCli, LeavesAnExistingFileAloneOnError) {
   { std::ofstream(csv()) << "keep\n"; }
-  const Result r = run("fpu --scheme sav --k zero --out " + csv());
+  const Result r = run("fpu --scheme sav-split --k 0.05 --out " + csv());
   EXPECT_EQ(r.exitCode, 2);
+  EXPECT_NE(r.err.find("(44)"), std::string::npos) << r.err;
   EXPECT_EQ(slurp(csv()), "keep\n");
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1);
+}
+
+// Times print exactly (17 digits: 3 · 0.1 is 0.30000000000000004), the last step is written,
+// and duration / k = 2.9999999999999996 still counts as 3 steps.
+TEST_F(SimCli, TimesAreExactAndTheLastStepIsWritten) {
+  ASSERT_EQ(run("fpu --scheme sav --k 0.1 --duration 0.3 --out " + csv()).exitCode, 0);
+  std::string header;
+  const auto rows = parseRows(slurp(csv()), header);
+  ASSERT_EQ(rows.size(), 4u);
+  for (size_t n = 0; n < rows.size(); ++n) EXPECT_EQ(rows[n][0], static_cast<double>(n) * 0.1);
+}
+
+// With loss the reported drift is that of energy + dissipated, which (50) keeps constant.
+TEST_F(SimCli, LossyRunReportsTheBalanceDrift) {
+  const Result r = run("fpu --scheme sav-split --sigma0 2 --alpha 10 --out " + csv());
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const auto at = r.out.find("drift (51): ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  EXPECT_LT(std::stod(r.out.substr(at + 12)), 1e-12) << r.out;
+  EXPECT_NE(r.out.find("dissipated"), std::string::npos) << r.out;
+}
+
+TEST_F(SimCli, RefusesSpecialFilesAndFollowsSymlinks) {
+  expectRefused("fpu --scheme sav --out /dev/null", "not a regular file");
+  const fs::path target = dir_ / "target.csv", link = dir_ / "link.csv";
+  { std::ofstream(target) << "old\n"; }
+  fs::permissions(target, fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read);
+  fs::create_symlink(target, link);
+  ASSERT_EQ(run("fpu --scheme sav --duration 0.01 --out " + link.string()).exitCode, 0);
+  EXPECT_TRUE(fs::is_symlink(link));
+  EXPECT_EQ(slurp(target).rfind("t,q1", 0), 0u);
+  EXPECT_EQ(fs::status(target).permissions() & fs::perms::all,
+            fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read);
+}
+
+TEST_F(SimCli, RefusesStartsAndOutputsBeyondDoublePrecision) {
+  const std::string ok = "fpu --scheme sav --out " + csv();
+  expectRefused(ok + " --alpha 1e100", "--alpha");
+  expectRefused(ok + " --alpha 1e-320", "too small");
+  expectRefused(ok + " --pairs 1000000 --duration 100", "--every");
+}
+
+// Killed mid-run, the program leaves neither the output nor its temporary.
+TEST_F(SimCli, InterruptedRunLeavesNoFile) {
+  const std::string cmd = std::string(HAMILTONE_SIM) +
+                          " fpu --scheme sav --pairs 1000 --duration 1e4 --every 1000 --out " +
+                          csv() +
+                          " >/dev/null 2>&1 & pid=$!; sleep 1; kill -TERM $pid; wait $pid; exit $?";
+  const int status = std::system(cmd.c_str());
+  EXPECT_EQ(WEXITSTATUS(status), 128 + SIGTERM);
+  EXPECT_TRUE(fs::is_empty(dir_)) << fs::directory_iterator(dir_)->path();
 }
 
 TEST_F(SimCli, StringWritesTheDocumentedCsv) {

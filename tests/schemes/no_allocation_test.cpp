@@ -72,19 +72,26 @@ TEST(NoAllocation, GuardIsArmed) {
       "heap allocation is forbidden");
 }
 
+// Lossless and lossy: the schemes branch on the loss once per step.
 TEST(NoAllocation, StormerVerlet) {
-  StormerVerlet<FermiPastaUlam> s(chain(), {.k = 1e-3, .sigma0 = 1.0}, start());
-  stepWithoutAllocating(s);
+  for (double sigma0 : {0.0, 1.0}) {
+    StormerVerlet<FermiPastaUlam> s(chain(), {.k = 1e-3, .sigma0 = sigma0}, start());
+    stepWithoutAllocating(s);
+  }
 }
 
 TEST(NoAllocation, NonSplitSav) {
-  NonSplitSav<FermiPastaUlam> s(chain(), {.k = 1e-3, .sigma0 = 1.0, .epsilon = 1.0}, start());
-  stepWithoutAllocating(s);
+  for (double sigma0 : {0.0, 1.0}) {
+    NonSplitSav<FermiPastaUlam> s(chain(), {.k = 1e-3, .sigma0 = sigma0, .epsilon = 1.0}, start());
+    stepWithoutAllocating(s);
+  }
 }
 
 TEST(NoAllocation, SplitSav) {
-  SplitSav<FermiPastaUlam> s(chain(), {.k = 1e-3, .sigma0 = 1.0, .epsilon = 1.0}, start());
-  stepWithoutAllocating(s);
+  for (double sigma0 : {0.0, 1.0}) {
+    SplitSav<FermiPastaUlam> s(chain(), {.k = 1e-3, .sigma0 = sigma0, .epsilon = 1.0}, start());
+    stepWithoutAllocating(s);
+  }
 }
 
 // The struck string with both losses: the stencils, the hammer contact and the σ1 operator.

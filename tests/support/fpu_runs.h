@@ -15,6 +15,35 @@ namespace hamiltone::testing {
 // BDZ §4.1.1: M = 3 pairs, ω = 50.
 inline FermiPastaUlam paperChain() { return FermiPastaUlam(3, 50.0); }
 
+// The FPU chain with unequal masses m_i = 1 + i/2 (M ≠ I), to catch a lost M or M⁻¹.
+struct WeightedChain {
+  static constexpr bool hasStiffness = true;
+  FermiPastaUlam chain = paperChain();
+  Vector inverseMassVector =
+      Vector::LinSpaced(chain.size(), 1.0, 1.0 + 0.5 * (chain.size() - 1)).cwiseInverse();
+  Eigen::Index size() const { return chain.size(); }
+  const Vector& inverseMass() const { return inverseMassVector; }
+  void applyStiffness(const Vector& q, Vector& out) const { chain.applyStiffness(q, out); }
+  // λmax(M^-½ K M^-½) <= λmax(K) / min(m) = ω²: a valid bound for (44).
+  double stiffnessEigenvalueMax() const { return chain.stiffnessEigenvalueMax(); }
+  double splitPotential(const Vector& q) const { return chain.splitPotential(q); }
+  double splitGradient(const Vector& q, Vector& grad) const { return chain.splitGradient(q, grad); }
+};
+
+// q(0) = α e₄ and a momentum in every coordinate, p_i = α (i − 2.5) / 4.
+inline InitialState movingStart(Eigen::Index n, double alpha) {
+  InitialState s{Vector::Zero(n), Vector::Zero(n)};
+  s.q[3] = alpha;
+  for (Eigen::Index i = 0; i < n; ++i) s.p[i] = alpha * (static_cast<double>(i) - 2.5) / 4.0;
+  return s;
+}
+
+// H(0) = ½ pᵀM⁻¹p + V(q) of a start.
+template <class S>
+double initialEnergy(const S& system, const FermiPastaUlam& chain, const InitialState& s) {
+  return 0.5 * s.p.dot(system.inverseMass().cwiseProduct(s.p)) + chain.potential(s.q);
+}
+
 // Steps a scheme `steps` times; the history of q^n for n = 0..steps.
 template <class Scheme>
 std::vector<Vector> trajectory(Scheme& scheme, long steps) {
