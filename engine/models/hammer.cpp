@@ -115,9 +115,9 @@ double HammeredString::partGradient(int part, const Vector& q, Vector& grad) con
     grad[hammerIndex()] = 0.0;
     return string_.splitGradient(q, grad);
   }
+  // Sparse: only the hammer and the contact points, all rewritten (PartitionedPotential).
   const double eta = compression(q);
   const double f = hammer_.force(eta);
-  grad.setZero();
   grad[hammerIndex()] = f;
   for (size_t i = 0; i < contactIndex_.size(); ++i) grad[contactIndex_[i]] = -contactWeight_[i] * f;
   return eta > 0.0 ? f * eta / (hammer_.felt().exponent + 1.0) : 0.0;

@@ -106,25 +106,39 @@ void NonlinearString::applyLossOperator(const Vector& a, const Vector& b, Vector
   }
 }
 
-// ζ_l = D₋u, η_l = D₋v on the M segments (u_0 = u_M = 0), s_l − 1 = (2η + η² + ζ²)/(s_l + 1)
-// without cancellation; V' = h (EA − T0)/2 Σ (s_l − 1)².
+namespace {
+
+// One segment's share of (65): with ζ, η its strains, returns (s − 1)² and sets φ (s − 1)/s, the
+// factor of ∂V'/∂ζ = c φ ζ and ∂V'/∂η = c φ (1 + η). s − 1 = (2η + η² + ζ²)/(s + 1): no
+// cancellation at small strain.
+inline double segmentExcess(double zeta, double eta, double& phi) {
+  const double stretch = std::sqrt((1.0 + eta) * (1.0 + eta) + zeta * zeta);
+  const double excess = (2.0 * eta + eta * eta + zeta * zeta) / (stretch + 1.0);
+  phi = excess / stretch;
+  return excess * excess;
+}
+
+}  // namespace
+
+// ζ_l = D₋u, η_l = D₋v on the M segments (u_0 = u_M = 0); V' = h (EA − T0)/2 Σ (s_l − 1)².
+// The end segments are taken apart so the loop over the others has no branch and vectorises.
 double NonlinearString::splitPotential(const Vector& q) const {
   const Eigen::Index m = segments_;
   const double* u = q.data();
   const double* v = q.data() + (m - 1);
   const double invH = 1.0 / h_;
-  double sum = 0.0;
-  for (Eigen::Index l = 0; l < m; ++l) {
-    const double zeta = ((l < m - 1 ? u[l] : 0.0) - (l > 0 ? u[l - 1] : 0.0)) * invH;
-    const double eta = ((l < m - 1 ? v[l] : 0.0) - (l > 0 ? v[l - 1] : 0.0)) * invH;
-    const double stretch = std::sqrt((1.0 + eta) * (1.0 + eta) + zeta * zeta);
-    const double excess = (2.0 * eta + eta * eta + zeta * zeta) / (stretch + 1.0);
-    sum += excess * excess;
+  double phi;
+  double sum = segmentExcess(u[0] * invH, v[0] * invH, phi) +
+               segmentExcess(-u[m - 2] * invH, -v[m - 2] * invH, phi);
+#pragma omp simd reduction(+ : sum)
+  for (Eigen::Index l = 1; l < m - 1; ++l) {
+    double f;
+    sum += segmentExcess((u[l] - u[l - 1]) * invH, (v[l] - v[l - 1]) * invH, f);
   }
   return 0.5 * h_ * (physics_.young * physics_.area - physics_.tension) * sum;
 }
 
-// ∂V'/∂ζ_l = φ_l ζ_l, ∂V'/∂η_l = φ_l (1 + η_l), φ_l = h (EA − T0)(s_l − 1)/s_l; then
+// ∂V'/∂ζ_l = c φ_l ζ_l, ∂V'/∂η_l = c φ_l (1 + η_l), c = h (EA − T0); then
 // ∇_u V' = D₋ᵀ(∂V'/∂ζ): (D₋ᵀ w)_j = (w_j − w_{j+1}) / h, likewise for v.
 double NonlinearString::splitGradient(const Vector& q, Vector& grad) const {
   const Eigen::Index m = segments_;
@@ -134,19 +148,21 @@ double NonlinearString::splitGradient(const Vector& q, Vector& grad) const {
   const double c = h_ * (physics_.young * physics_.area - physics_.tension);
   double* wz = work1_.data();
   double* we = work2_.data();
-  double sum = 0.0;
-  for (Eigen::Index l = 0; l < m; ++l) {
-    const double zeta = ((l < m - 1 ? u[l] : 0.0) - (l > 0 ? u[l - 1] : 0.0)) * invH;
-    const double eta = ((l < m - 1 ? v[l] : 0.0) - (l > 0 ? v[l - 1] : 0.0)) * invH;
-    const double stretch = std::sqrt((1.0 + eta) * (1.0 + eta) + zeta * zeta);
-    const double excess = (2.0 * eta + eta * eta + zeta * zeta) / (stretch + 1.0);
-    sum += excess * excess;
-    const double phi = c * excess / stretch;
-    wz[l] = phi * zeta;
-    we[l] = phi * (1.0 + eta);
-  }
+  auto segment = [&](Eigen::Index l, double zeta, double eta) {
+    double phi;
+    const double e = segmentExcess(zeta, eta, phi);
+    wz[l] = c * phi * zeta;
+    we[l] = c * phi * (1.0 + eta);
+    return e;
+  };
+  double sum =
+      segment(0, u[0] * invH, v[0] * invH) + segment(m - 1, -u[m - 2] * invH, -v[m - 2] * invH);
+#pragma omp simd reduction(+ : sum)
+  for (Eigen::Index l = 1; l < m - 1; ++l)
+    sum += segment(l, (u[l] - u[l - 1]) * invH, (v[l] - v[l - 1]) * invH);
   double* gu = grad.data();
   double* gv = grad.data() + (m - 1);
+#pragma omp simd
   for (Eigen::Index j = 0; j < m - 1; ++j) {
     gu[j] = (wz[j] - wz[j + 1]) * invH;
     gv[j] = (we[j] - we[j + 1]) * invH;

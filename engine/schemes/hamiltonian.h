@@ -25,7 +25,9 @@ concept HamiltonianSystem = requires(const S& s, const Vector& q, Vector& out) {
 // A model whose V' is a sum V' = Σ_j V'_j of parts quadratised separately, each with its own
 // auxiliary variable ψ_j (SCHEMES §3: one SAV per nonlinearity, rank-P Woodbury update), so that
 // the error of one part's ψ does not leak into the others' forces. splitPotential and
-// splitGradient still give the sum.
+// splitGradient still give the sum. partGradient is handed the vector it filled for the same
+// part the time before (zeros at first), so a sparse part may rewrite only its own entries;
+// V'_j = 0 must mean ∇V'_j = 0 (true of any differentiable V'_j >= 0).
 template <class S>
 concept PartitionedPotential = requires(const S& s, const Vector& q, Vector& out, int j) {
   { S::potentialParts } -> std::convertible_to<int>;

@@ -37,6 +37,7 @@ class LinearLoss {
     }
     cq_.setZero(system.size());
     diff_.setZero(system.size());
+    mass_ = system.inverseMass().cwiseInverse();
   }
 
   bool any() const { return sigma0_ > 0.0 || sigma1_ > 0.0; }
@@ -99,6 +100,7 @@ class LinearLoss {
  private:
   double sigma0_ = 0.0, sigma1_ = 0.0, k_ = 0.0;
   Vector cq_;            // C (q^n − q^{n−1})
+  Vector mass_;          // diagonal of M
   mutable Vector diff_;  // scratch of dissipation() and kineticCorrection()
 };
 

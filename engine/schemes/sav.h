@@ -104,6 +104,7 @@ class SavScheme {
   const Vector& qNext() const { return curr_; }
   double psi(int part = 0) const { return psi_[part]; }  // ψ_j^{n+½}
   // Energy taken by the loss since the start: energy().total() + dissipated() is constant (50).
+  // Zero when the parameters turned trackDissipation off.
   double dissipated() const { return dissipated_; }
   const S& system() const { return system_; }
   const StepParameters& parameters() const { return params_; }
@@ -127,24 +128,34 @@ class SavScheme {
 
     // (39): g_j = ∇V'_j / sqrt(2 (V'_j + ε)), g_j = 0 where V'_j + ε = 0; grads_ hold ∇V'_j, so
     // g_j = s_j ∇V'_j, and α_j = h_j M⁻¹∇V'_j, β_j = h_j ∇V'_j   (31).
+    // A slack part (V'_j = 0, so ∇V'_j = 0: a hammer off the string) adds nothing to the update;
+    // with at most one part under load the scalar one-part passes below serve.
     std::array<const double*, parts> g;
     double s[parts], h[parts];
+    int loaded = 0, onlyLoaded = 0;
     for (int j = 0; j < parts; ++j) {
-      const double shifted = gradient(j) + params_.epsilon;
+      const double potential = gradient(j);
+      const double shifted = potential + params_.epsilon;
       s[j] = shifted > 0.0 ? 1.0 / std::sqrt(2.0 * shifted) : 0.0;
       h[j] = 0.5 * k * s[j];
       g[j] = grads_[j].data();
+      if (potential != 0.0 || parts == 1) {
+        ++loaded;
+        onlyLoaded = j;
+      }
     }
+    const bool onePass = parts == 1 || loaded <= 1;
     const double twoSigma1K = 2.0 * params_.sigma1 * k;
     const double* cq = lossy ? loss_.frequencyForce(system_, curr_, prev_).data() : nullptr;
 
     // Pass 1: ∇V'_jᵀ of q^n, q^{n−1}, M⁻¹K q^n, M⁻¹C(q^n − q^{n−1}), and ∇V'_iᵀ M⁻¹ ∇V'_j.
-    // With one part the sums are scalars, which GCC keeps in registers; array reductions cost
-    // it a third more on the 1000-pair FPU chain.
+    // With one part loaded the sums are scalars, which GCC keeps in registers; array
+    // reductions cost it a third more on the 1000-pair FPU chain.
     double gq[parts] = {}, gqm[parts] = {}, gMKq[parts] = {}, gMCq[parts] = {};
     double gMg[parts * parts] = {};
-    if constexpr (parts == 1) {
-      const double* g0 = g[0];
+    if (onePass) {
+      const int a = onlyLoaded;
+      const double* g0 = g[a];
       double sq = 0.0, sqm = 0.0, sMKq = 0.0, sMCq = 0.0, sMg = 0.0;
 #pragma omp simd reduction(+ : sq, sqm, sMKq, sMCq, sMg)
       for (Eigen::Index i = 0; i < n; ++i) {
@@ -154,7 +165,7 @@ class SavScheme {
         if constexpr (lossy) sMCq += g0[i] * (minv[i] * cq[i]);
         sMg += g0[i] * minv[i] * g0[i];
       }
-      gq[0] = sq, gqm[0] = sqm, gMKq[0] = sMKq, gMCq[0] = sMCq, gMg[0] = sMg;
+      gq[a] = sq, gqm[a] = sqm, gMKq[a] = sMKq, gMCq[a] = sMCq, gMg[a * parts + a] = sMg;
     } else {
 #pragma omp simd reduction(+ : gq[:parts], gqm[:parts], gMKq[:parts], gMCq[:parts], \
                                gMg[:parts * parts])
@@ -200,13 +211,15 @@ class SavScheme {
       return qp[i] = (b + correction) * invUp;
     };
     double gdq[parts] = {};
-    if constexpr (parts == 1) {
-      const double* g0 = g[0];
+    if (onePass) {
+      const int a = onlyLoaded;
+      const double* g0 = g[a];
+      const double ca = c[a];
       double sdq = 0.0;
 #pragma omp simd reduction(+ : sdq)
       for (Eigen::Index i = 0; i < n; ++i)
-        sdq += g0[i] * (newPosition(i, c[0] * (minv[i] * g0[i])) - qm[i]);
-      gdq[0] = sdq;
+        sdq += g0[i] * (newPosition(i, ca * (minv[i] * g0[i])) - qm[i]);
+      gdq[a] = sdq;
     } else {
 #pragma omp simd reduction(+ : gdq[:parts])
       for (Eigen::Index i = 0; i < n; ++i) {
@@ -216,8 +229,11 @@ class SavScheme {
         for (int a = 0; a < parts; ++a) gdq[a] += g[a][i] * (x - qm[i]);
       }
     }
-    for (int a = 0; a < parts; ++a) psi_[a] += 0.5 * s[a] * gdq[a];                // (38c)
-    if constexpr (lossy) dissipated_ += loss_.dissipation(system_, next_, prev_);  // (50)
+    for (int a = 0; a < parts; ++a) psi_[a] += 0.5 * s[a] * gdq[a];  // (38c)
+    if constexpr (lossy) {
+      if (params_.trackDissipation)
+        dissipated_ += loss_.dissipation(system_, next_, prev_);  // (50)
+    }
 
     prev_.swap(curr_);
     curr_.swap(next_);

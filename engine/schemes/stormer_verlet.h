@@ -42,7 +42,8 @@ class StormerVerlet {
               invUp;
     else
       next_ = (2.0 * curr_ - down * prev_ - (k * k) * minv.cwiseProduct(grad_)) * invUp;
-    if (loss_.any()) dissipated_ += loss_.dissipation(system_, next_, prev_);
+    if (loss_.any() && params_.trackDissipation)
+      dissipated_ += loss_.dissipation(system_, next_, prev_);
     prev_.swap(curr_);
     curr_.swap(next_);
     ++n_;

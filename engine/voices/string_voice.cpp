@@ -89,8 +89,11 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
   const HammeredString system(NonlinearString(tuned.physics, tuned.segments), patch.hammer);
   InitialState rest{Vector::Zero(system.size()), Vector::Zero(system.size())};
   rest.q[system.hammerIndex()] = kParkedAt;
-  const StepParameters params{
-      .k = k_, .sigma0 = loss_.sigma0, .sigma1 = loss_.sigma1, .epsilon = patch.epsilon};
+  const StepParameters params{.k = k_,
+                              .sigma0 = loss_.sigma0,
+                              .sigma1 = loss_.sigma1,
+                              .epsilon = patch.epsilon,
+                              .trackDissipation = false};
   scheme_ = std::make_unique<SplitSav<HammeredString>>(system, params, rest);
   atRest_ = std::make_unique<SplitSav<HammeredString>>(*scheme_);
   fundamental_ = schemePartial(system.string(), k_, 1);
@@ -110,8 +113,6 @@ void StringVoice::reset() noexcept {
 int StringVoice::segments() const { return scheme_->system().string().segments(); }
 
 double StringVoice::energy() const { return scheme_->energy().total(); }
-
-double StringVoice::dissipatedEnergy() const { return scheme_->dissipated() + caught_; }
 
 void StringVoice::noteOn(double velocity) noexcept {
   const double v = velocity >= 0.0 ? std::min(velocity, 1.0) : 0.0;  // NaN too

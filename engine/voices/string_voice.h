@@ -61,7 +61,10 @@ class StringVoice {
   bool active() const { return active_; }
   double energy() const;  // the scheme's H^{n+½} (ε excluded), J
   double injectedEnergy() const { return injected_; }
-  double dissipatedEnergy() const;  // by loss, damper and the caught hammer
+  // Taken out by the back-check (the hammer's kinetic energy and its ψ residual). The string's
+  // losses are not tallied on the audio path; with them off, energy() + removedEnergy() stays
+  // injectedEnergy().
+  double removedEnergy() const { return caught_; }
   int guardEvents() const { return guardEvents_; }
   double fundamentalHz() const { return fundamental_; }
   int segments() const;
