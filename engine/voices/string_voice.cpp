@@ -115,6 +115,9 @@ int StringVoice::segments() const { return scheme_->system().string().segments()
 double StringVoice::energy() const { return scheme_->energy().total(); }
 
 void StringVoice::noteOn(double velocity) noexcept {
+  // A freed voice starts from rest: what a decayed string keeps on the transverse grid (a static
+  // longitudinal stretch the SAV can leave, see docs/string-grids.md) would detune the next note.
+  if (!active_) reset();
   const double v = velocity >= 0.0 ? std::min(velocity, 1.0) : 0.0;  // NaN too
   const double speed = patch_.velocityMin + (patch_.velocityMax - patch_.velocityMin) *
                                                 std::pow(v, patch_.velocityCurve);

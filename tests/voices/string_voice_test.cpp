@@ -117,6 +117,10 @@ TEST(StringVoice, DamperShortensTheDecayToItsT60) {
   EXPECT_NEAR(measuredT60(voice, 0.0, 0.4), 0.3, 0.05 * 0.3);
   play(voice, 3.0, 48000.0, [] {});  // 120 dB down and more: the voice frees itself
   EXPECT_FALSE(voice.active());
+  // Struck again, the freed voice starts from rest: the injected energy is the strike's alone.
+  voice.noteOn(0.5);
+  const double speed = 0.5 + 5.5 * 0.5;
+  EXPECT_NEAR(voice.injectedEnergy(), 0.5 * HammerFelt{}.mass * speed * speed, 1e-9);
 }
 
 // A gauge shift of 1e30 J drowns the energy (41) in roundoff (the ulp of 1e30 is ~1e14 J):
