@@ -7,16 +7,12 @@
 #include <Eigen/Eigenvalues>
 #include <random>
 
+#include "support/energy_checks.h"
+
 namespace hamiltone {
 namespace {
 
-Vector randomState(Eigen::Index n, double scale, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(-scale, scale);
-  Vector q(n);
-  for (auto& x : q) x = u(rng);
-  return q;
-}
+using testing::randomVector;
 
 Eigen::MatrixXd stiffnessMatrix(const FermiPastaUlam& chain) {
   const Eigen::Index n = chain.size();
@@ -36,7 +32,7 @@ TEST(FermiPastaUlam, SplitPotentialAddsUpToThePaperPotential) {
     FermiPastaUlam chain(pairs, 50.0);
     Vector kq(chain.size());
     for (unsigned seed = 0; seed < 5; ++seed) {
-      const Vector q = randomState(chain.size(), 2.0, seed);
+      const Vector q = randomVector(chain.size(), 2.0, seed);
       chain.applyStiffness(q, kq);
       const double split = 0.5 * q.dot(kq) + chain.splitPotential(q);  // (53)
       // Both sums are of positive terms: agreement to a few ulps of the total.
@@ -49,21 +45,13 @@ TEST(FermiPastaUlam, GradientIsTheDerivativeOfThePotential) {
   FermiPastaUlam chain(5, 50.0);
   Vector grad(chain.size());
   for (unsigned seed = 0; seed < 5; ++seed) {
-    Vector q = randomState(chain.size(), 1.5, seed);
+    Vector q = randomVector(chain.size(), 1.5, seed);
     const double v = chain.splitGradient(q, grad);
     EXPECT_DOUBLE_EQ(v, chain.splitPotential(q));
     // Central differences: error O(δ²) times the third derivative (~24 e), roundoff ~ 1e-16 V / δ.
-    const double delta = 1e-5;
-    for (Eigen::Index j = 0; j < q.size(); ++j) {
-      const double saved = q[j];
-      q[j] = saved + delta;
-      const double up = chain.splitPotential(q);
-      q[j] = saved - delta;
-      const double down = chain.splitPotential(q);
-      q[j] = saved;
-      EXPECT_NEAR(grad[j], (up - down) / (2.0 * delta), 1e-6 * (1.0 + std::abs(grad[j])))
-          << "coordinate " << j;
-    }
+    testing::expectGradientIsDerivative([&](const Vector& x) { return chain.splitPotential(x); },
+                                        grad, q, [](Eigen::Index) { return 1e-5; },
+                                        1e-6 * (1.0 + grad.cwiseAbs().maxCoeff()));
   }
 }
 

@@ -2,8 +2,6 @@
 // and the bound (44) rely on, the loss operator is −ρA h D2, and unphysical strings are refused.
 #include "models/string.h"
 
-#include "schemes/sav.h"
-
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
@@ -11,6 +9,9 @@
 #include <cmath>
 #include <numbers>
 #include <random>
+
+#include "schemes/sav.h"
+#include "support/energy_checks.h"
 
 namespace hamiltone {
 namespace {
@@ -22,13 +23,7 @@ StringPhysics c3(bool stiff = true) {
   return p;
 }
 
-Vector randomState(Eigen::Index n, double scale, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(-scale, scale);
-  Vector q(n);
-  for (auto& x : q) x = u(rng);
-  return q;
-}
+using testing::randomVector;
 
 Eigen::MatrixXd matrixOf(const NonlinearString& s, auto apply) {
   const Eigen::Index n = s.size();
@@ -50,21 +45,13 @@ TEST(NonlinearString, GradientIsTheDerivativeOfTheSplitPotential) {
   const Eigen::Index n = string.size(), half = n / 2;
   Vector grad(n);
   for (unsigned seed = 0; seed < 4; ++seed) {
-    Vector q = randomState(n, 3e-3, seed);
+    Vector q = randomVector(n, 3e-3, seed);
     q.tail(half) *= 1e-3;
     const double v = string.splitGradient(q, grad);
     EXPECT_DOUBLE_EQ(v, string.splitPotential(q));
-    const double scale = grad.cwiseAbs().maxCoeff();
-    for (Eigen::Index j = 0; j < n; ++j) {
-      const double delta = j < half ? 1e-7 : 1e-10;
-      const double saved = q[j];
-      q[j] = saved + delta;
-      const double up = string.splitPotential(q);
-      q[j] = saved - delta;
-      const double down = string.splitPotential(q);
-      q[j] = saved;
-      EXPECT_NEAR(grad[j], (up - down) / (2.0 * delta), 1e-6 * scale) << "coordinate " << j;
-    }
+    testing::expectGradientIsDerivative(
+        [&](const Vector& x) { return string.splitPotential(x); }, grad, q,
+        [&](Eigen::Index j) { return j < half ? 1e-7 : 1e-10; }, 1e-6 * grad.cwiseAbs().maxCoeff());
   }
 }
 
@@ -103,7 +90,7 @@ TEST(NonlinearString, StiffnessHasTheClosedFormSpectrum) {
 TEST(NonlinearString, LossOperatorIsMinusRhoAhD2OfTheDifference) {
   const NonlinearString string(c3(), 12);
   const Eigen::Index n = string.size();
-  const Vector a = randomState(n, 1.0, 7), b = randomState(n, 1.0, 8);
+  const Vector a = randomVector(n, 1.0, 7), b = randomVector(n, 1.0, 8);
   Vector out(n);
   string.applyLossOperator(a, b, out);
   const Eigen::MatrixXd c = matrixOf(
@@ -149,18 +136,10 @@ TEST(NonlinearString, LossBalanceClosesAtAudioRate) {
     u[j - 1] = 10.0 * std::sqrt(p.area) * std::sin(std::numbers::pi * j / string.segments());
   SplitSav<NonlinearString> scheme(string, {.k = k, .sigma0 = 1.0, .sigma1 = sigma1},
                                    {u, Vector::Zero(string.size())});
-  const double h0 = scheme.energy().total();
-  double previous = h0, worstIncrease = 0.0, worstBalance = 0.0;
-  for (long n = 0; n < 96000; ++n) {
-    scheme.step();
-    const double h = scheme.energy().total();
-    worstIncrease = std::max(worstIncrease, (h - previous) / h0);
-    worstBalance = std::max(worstBalance, std::abs(h + scheme.dissipated() - h0) / h0);
-    previous = h;
-  }
-  EXPECT_LE(worstIncrease, 1e-14);
-  EXPECT_LE(worstBalance, 1e-10);
-  EXPECT_LT(previous, 0.1 * h0);
+  const testing::Balance b = testing::runBalance(scheme, 96000);
+  EXPECT_LE(b.worstIncrease, 1e-14);
+  EXPECT_LE(b.worstBalance, 1e-10);
+  EXPECT_LT(b.final, 0.1 * b.initial);
 }
 
 TEST(NonlinearString, RefusesUnphysicalStrings) {

@@ -2,6 +2,7 @@
 // the stability bound (44), and unconditional stability of (27) where Störmer–Verlet blows up.
 #include <gtest/gtest.h>
 
+#include "support/energy_checks.h"
 #include "support/fpu_runs.h"
 
 namespace hamiltone {
@@ -79,20 +80,12 @@ template <class Scheme>
 void expectBalancedLoss() {
   const FermiPastaUlam chain = paperChain();
   Scheme scheme(chain, {.k = 1e-3, .sigma0 = 2.0}, fpuInitialState(chain, 50.0));
-  const double h0 = scheme.energy().total();
-  double previous = h0, worstIncrease = 0.0, worstBalance = 0.0;
-  for (long n = 0; n < 1000; ++n) {
-    scheme.step();
-    const double h = scheme.energy().total();
-    worstIncrease = std::max(worstIncrease, (h - previous) / h0);
-    worstBalance = std::max(worstBalance, std::abs(h + scheme.dissipated() - h0) / h0);
-    previous = h;
-  }
-  EXPECT_LE(worstIncrease, 1e-14);
-  EXPECT_LE(worstBalance, 1e-12);
+  const testing::Balance b = testing::runBalance(scheme, 1000);
+  EXPECT_LE(b.worstIncrease, 1e-14);
+  EXPECT_LE(b.worstBalance, 1e-12);
   // The loss is real: with σ0 = 2/s the energy falls by about e^{−2σ0 t} ≈ e^{−4} in 1 s.
-  EXPECT_LT(previous, 0.1 * h0);
-  EXPECT_GT(scheme.dissipated(), 0.9 * h0);
+  EXPECT_LT(b.final, 0.1 * b.initial);
+  EXPECT_GT(scheme.dissipated(), 0.9 * b.initial);
 }
 
 TEST(SplitSav, LossNeverAddsEnergyAndTheBalanceCloses) {

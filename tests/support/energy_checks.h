@@ -1,0 +1,62 @@
+// Checks several tests make: random states, gradients against finite differences, and the loss
+// balance (50) over a run.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "schemes/hamiltonian.h"
+
+namespace hamiltone::testing {
+
+inline Vector randomVector(Eigen::Index n, double scale, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-scale, scale);
+  Vector q(n);
+  for (auto& x : q) x = u(rng);
+  return q;
+}
+
+// Each entry of `grad` (the gradient at q) against the central difference of `potential` with
+// step delta(j), to `tolerance`.
+template <class Potential, class Delta>
+void expectGradientIsDerivative(Potential potential, const Vector& grad, Vector q, Delta delta,
+                                double tolerance) {
+  for (Eigen::Index j = 0; j < q.size(); ++j) {
+    const double d = delta(j), saved = q[j];
+    q[j] = saved + d;
+    const double up = potential(q);
+    q[j] = saved - d;
+    const double down = potential(q);
+    q[j] = saved;
+    EXPECT_NEAR(grad[j], (up - down) / (2.0 * d), tolerance) << "coordinate " << j;
+  }
+}
+
+struct Balance {
+  double initial = 0.0;        // H at the start
+  double final = 0.0;          // H at the end
+  double worstIncrease = 0.0;  // largest step-to-step rise of H, relative to the start
+  double worstBalance = 0.0;   // largest |H + dissipated − H(0)|, relative to the start
+};
+
+// Steps a lossy scheme and measures how (50) holds.
+template <class Scheme>
+Balance runBalance(Scheme& scheme, long steps) {
+  Balance b;
+  b.initial = b.final = scheme.energy().total();
+  for (long n = 0; n < steps; ++n) {
+    scheme.step();
+    const double h = scheme.energy().total();
+    b.worstIncrease = std::max(b.worstIncrease, (h - b.final) / b.initial);
+    b.worstBalance =
+        std::max(b.worstBalance, std::abs(h + scheme.dissipated() - b.initial) / b.initial);
+    b.final = h;
+  }
+  return b;
+}
+
+}  // namespace hamiltone::testing
