@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "models/fpu.h"
+#include "recording_reporter.h"
 #include "schemes/marazzato.h"
 #include "schemes/sav.h"
 #include "schemes/stormer_verlet.h"
@@ -71,33 +72,13 @@ void registerBenchmarks() {
   }
 }
 
-// The console table, plus each benchmark's real time per step, so that the ratios come from
-// the very runs the table shows.
-class RecordingReporter : public benchmark::ConsoleReporter {
- public:
-  // Tabular without colour: the output mostly ends up in logs, where escape codes are noise.
-  RecordingReporter() : ConsoleReporter(OO_Tabular) {}
-
-  void ReportRuns(const std::vector<Run>& runs) override {
-    ConsoleReporter::ReportRuns(runs);
-    // With --benchmark_repetitions the median arrives after the single runs and replaces them.
-    for (const Run& run : runs) {
-      const bool median = run.run_type == Run::RT_Aggregate && run.aggregate_name == "median";
-      if (run.error_occurred || !(run.run_type == Run::RT_Iteration || median)) continue;
-      timePerStep_[run.run_name.function_name] = run.GetAdjustedRealTime();
-    }
-  }
-
-  void printRatio(const char* scheme, int pairs) const {
-    const auto num = timePerStep_.find(benchmarkName(scheme, pairs));
-    const auto den = timePerStep_.find(benchmarkName(kSv, pairs));
-    if (num == timePerStep_.end() || den == timePerStep_.end()) return;  // filtered out or failed
-    std::printf("%-22s / %s  pairs %4d: %.3f\n", scheme, kSv, pairs, num->second / den->second);
-  }
-
- private:
-  std::map<std::string, double> timePerStep_;
-};
+// The cost of `scheme` relative to Störmer–Verlet on the same chain, from the recorded runs.
+void printRatio(const RecordingReporter& runs, const char* scheme, int pairs) {
+  const auto* num = runs.find(benchmarkName(scheme, pairs));
+  const auto* den = runs.find(benchmarkName(kSv, pairs));
+  if (!num || !den) return;  // filtered out or failed
+  std::printf("%-22s / %s  pairs %4d: %.3f\n", scheme, kSv, pairs, num->seconds / den->seconds);
+}
 
 }  // namespace
 }  // namespace hamiltone
@@ -113,6 +94,6 @@ int main(int argc, char** argv) {
 
   std::printf("\nCost relative to Stormer-Verlet (20), real time per step:\n");
   for (int pairs : kChainPairs)
-    for (const char* scheme : {kSplit, kNonSplit, kMidpoint}) reporter.printRatio(scheme, pairs);
+    for (const char* scheme : {kSplit, kNonSplit, kMidpoint}) printRatio(reporter, scheme, pairs);
   return 0;
 }

@@ -12,6 +12,7 @@
 
 #include "models/string.h"
 #include "presets/piano_scale.h"
+#include "recording_reporter.h"
 #include "schemes/sav.h"
 #include "schemes/stormer_verlet.h"
 #include "voices/string_voice.h"
@@ -199,39 +200,6 @@ SchemeGrids registerBenchmarks() {
   addScheme(kOwnLimitSv, Sv(coarse, {.k = g.svK}, coarseStart), 1.0 / g.svK);
   return g;
 }
-
-// The console table, plus each benchmark's real time per iteration and its counters, so that the
-// summary after the run comes from the very runs the table shows.
-class RecordingReporter : public benchmark::ConsoleReporter {
- public:
-  struct Record {
-    double seconds;  // real time per iteration
-    benchmark::UserCounters counters;
-  };
-
-  // Tabular without colour: the output mostly ends up in logs, where escape codes are noise.
-  RecordingReporter() : ConsoleReporter(OO_Tabular) {}
-
-  void ReportRuns(const std::vector<Run>& runs) override {
-    ConsoleReporter::ReportRuns(runs);
-    // With --benchmark_repetitions the median arrives after the single runs and replaces them.
-    for (const Run& run : runs) {
-      const bool median = run.run_type == Run::RT_Aggregate && run.aggregate_name == "median";
-      if (run.error_occurred || !(run.run_type == Run::RT_Iteration || median)) continue;
-      records_[run.run_name.function_name] = {
-          run.GetAdjustedRealTime() / benchmark::GetTimeUnitMultiplier(run.time_unit),
-          run.counters};
-    }
-  }
-
-  const Record* find(const std::string& name) const {
-    const auto it = records_.find(name);
-    return it == records_.end() ? nullptr : &it->second;
-  }
-
- private:
-  std::map<std::string, Record> records_;
-};
 
 const char* verdict(bool met) { return met ? "met" : "NOT met"; }
 
