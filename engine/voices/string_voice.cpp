@@ -19,6 +19,7 @@ constexpr double kLn1000 = 6.907755278982137;  // T60 = ln(1000) / σ
 constexpr double kStrikeGap = 1e-4;            // m: the hammer starts 0.1 mm below the string
 constexpr double kParkedAt = -0.02;            // m: where the back-check holds it
 constexpr double kCheckDelay = 1e-3;           // s out of contact, moving away, before the catch
+constexpr double kCheckGap = 1e-3;             // m below the string, at least, when caught
 
 void require(bool ok, const char* field, double value, const std::string& valid) {
   if (!ok)
@@ -74,30 +75,40 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
   require(std::isfinite(patch.epsilon) && patch.epsilon >= 0.0, "epsilon_j", patch.epsilon,
           "a finite number >= 0 J");
 
-  patch_ = patch;
-  sampleRate_ = sampleRate;
-  k_ = 1.0 / (sampleRate * r);
+  // Everything is built in locals and committed only once nothing more can throw, so a failed
+  // prepare() leaves the voice as it was.
+  const double k = 1.0 / (sampleRate * r);
   const double target = equalTemperament(midiNote, patch.a4Hz);
   // The loss sets the grid (its σ1 tightens (44)) and the tuning sets the loss (ξ depends on T0):
   // two rounds settle both, σ1 being a small correction.
   TunedString tuned{patch.string, 0};
+  StringLoss loss;
   for (int round = 0; round < 2; ++round) {
-    loss_ = stringLossFromT60(tuned.physics, patch.t60Low, patch.t60High, patch.t60HighHz);
-    tuned = tuneString(patch.string, patch.tuneBy, patch.grid, k_, loss_.sigma1, patch.gridFactor,
+    loss = stringLossFromT60(tuned.physics, patch.t60Low, patch.t60High, patch.t60HighHz);
+    tuned = tuneString(patch.string, patch.tuneBy, patch.grid, k, loss.sigma1, patch.gridFactor,
                        target);
   }
   const HammeredString system(NonlinearString(tuned.physics, tuned.segments), patch.hammer);
   InitialState rest{Vector::Zero(system.size()), Vector::Zero(system.size())};
   rest.q[system.hammerIndex()] = kParkedAt;
-  const StepParameters params{.k = k_,
-                              .sigma0 = loss_.sigma0,
-                              .sigma1 = loss_.sigma1,
+  const StepParameters params{.k = k,
+                              .sigma0 = loss.sigma0,
+                              .sigma1 = loss.sigma1,
                               .epsilon = patch.epsilon,
                               .trackDissipation = false};
-  scheme_ = std::make_unique<SplitSav<HammeredString>>(system, params, rest);
-  atRest_ = std::make_unique<SplitSav<HammeredString>>(*scheme_);
-  fundamental_ = schemePartial(system.string(), k_, 1);
-  for (Decimator& d : decimators_) d.prepare(r);
+  auto scheme = std::make_unique<SplitSav<HammeredString>>(system, params, rest);
+  auto atRest = std::make_unique<SplitSav<HammeredString>>(*scheme);
+  Decimator decimators[2];
+  for (Decimator& d : decimators) d.prepare(r);
+
+  patch_ = patch;
+  sampleRate_ = sampleRate;
+  k_ = k;
+  loss_ = loss;
+  fundamental_ = schemePartial(system.string(), k, 1);
+  scheme_ = std::move(scheme);
+  atRest_ = std::move(atRest);
+  for (int c = 0; c < 2; ++c) decimators_[c] = std::move(decimators[c]);
   reset();
 }
 
@@ -124,12 +135,15 @@ void StringVoice::noteOn(double velocity) noexcept {
   const HammeredString& system = scheme_->system();
   const Eigen::Index w = system.hammerIndex();
   const double before = energy();
-  // Out of contact, the hammer is placed just below the string and launched; in contact (a very
-  // fast repeat) it is only given the new speed where it is.
+  // Out of contact, the hammer is placed below the string — far enough that its first step,
+  // speed·k, does not reach the felt — and launched; in contact (a very fast repeat) it is only
+  // given the new speed where it is. Either way ψ of the felt is set to match Φ there.
+  const double gap = std::max(kStrikeGap, 2.0 * speed * k_);
   const double start = system.compression(scheme_->q()) > 0.0
                            ? scheme_->q()[w]
-                           : system.contactDisplacement(scheme_->q()) - kStrikeGap;
+                           : system.contactDisplacement(scheme_->q()) - gap;
   scheme_->setCoordinate(w, start, start + speed * k_);
+  scheme_->resetPsi(1);
   injected_ += energy() - before;
   scheme_->setSigma0(loss_.sigma0);
   separatedSteps_ = 0;
@@ -156,7 +170,14 @@ void StringVoice::catchHammer() noexcept {
     separatedSteps_ = 0;
     return;
   }
-  if (!struck_ || ++separatedSteps_ * k_ < kCheckDelay) return;
+  // Falling away, clear of the string by a millimetre, and for a millisecond: a string wave
+  // coming back can still meet a hammer that lingers near it.
+  const bool away = scheme_->qNext()[w] < q[w] && system.compression(q) < -kCheckGap;
+  if (!struck_ || !away) {
+    separatedSteps_ = 0;
+    return;
+  }
+  if (++separatedSteps_ * k_ < kCheckDelay) return;
   const double before = energy();
   scheme_->setCoordinate(w, kParkedAt, kParkedAt);
   scheme_->resetPsi(1);
@@ -175,10 +196,12 @@ double StringVoice::pickup(const Vector& q, const Vector& qNext, double position
 }
 
 void StringVoice::process(std::span<float> left, std::span<float> right) noexcept {
-  const bool stereo = patch_.channels == 2 && right.size() >= left.size();
+  // Stereo writes the right channel too, over as many samples as it has; a mono patch leaves it.
+  const bool stereo = patch_.channels == 2 && !right.empty();
+  const size_t rightCount = stereo ? std::min(left.size(), right.size()) : 0;
   if (!active_) {
     std::fill(left.begin(), left.end(), 0.0f);
-    if (stereo) std::fill(right.begin(), right.begin() + left.size(), 0.0f);
+    std::fill(right.begin(), right.begin() + rightCount, 0.0f);
     return;
   }
   bool finite = true;
@@ -194,15 +217,18 @@ void StringVoice::process(std::span<float> left, std::span<float> right) noexcep
         ready = decimators_[c].push(pickup(q, qNext, patch_.pickups[c]), out[c]);
     }
     left[i] = static_cast<float>(patch_.gain * out[0]);
-    if (stereo) right[i] = static_cast<float>(patch_.gain * out[1]);
-    finite = finite && std::isfinite(left[i]) && (!stereo || std::isfinite(right[i]));
+    finite = finite && std::isfinite(left[i]);
+    if (i < rightCount) {
+      right[i] = static_cast<float>(patch_.gain * out[1]);
+      finite = finite && std::isfinite(right[i]);
+    }
   }
   // The guard: a non-finite sample or runaway energy never leaves the voice.
   const Energy e = scheme_->energy();
   const double h = e.total();
   if (!finite || !std::isfinite(h) || h > patch_.guardEnergyMultiple * injected_) {
     std::fill(left.begin(), left.end(), 0.0f);
-    if (stereo) std::fill(right.begin(), right.begin() + left.size(), 0.0f);
+    std::fill(right.begin(), right.begin() + rightCount, 0.0f);
     ++guardEvents_;
     reset();
     return;

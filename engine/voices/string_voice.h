@@ -55,7 +55,8 @@ class StringVoice {
   void noteOn(double velocity) noexcept;  // velocity 0 … 1
   void release() noexcept;                // the damper falls
 
-  // Writes (not adds) the next samples; right is ignored for a mono patch. Never allocates.
+  // Writes (not adds) the next left.size() samples; a stereo patch also writes the first
+  // min(left, right) samples of right, a mono one leaves right alone. Never allocates.
   void process(std::span<float> left, std::span<float> right) noexcept;
 
   bool active() const { return active_; }

@@ -21,10 +21,11 @@ inline Vector randomVector(Eigen::Index n, double scale, unsigned seed) {
 }
 
 // Each entry of `grad` (the gradient at q) against the central difference of `potential` with
-// step delta(j), to `tolerance`.
+// step delta(j), to `relative` of the entry — plus `floor`, the roundoff of a difference of
+// potentials, for entries near zero.
 template <class Potential, class Delta>
 void expectGradientIsDerivative(Potential potential, const Vector& grad, Vector q, Delta delta,
-                                double tolerance) {
+                                double relative, double floor) {
   for (Eigen::Index j = 0; j < q.size(); ++j) {
     const double d = delta(j), saved = q[j];
     q[j] = saved + d;
@@ -32,7 +33,8 @@ void expectGradientIsDerivative(Potential potential, const Vector& grad, Vector 
     q[j] = saved - d;
     const double down = potential(q);
     q[j] = saved;
-    EXPECT_NEAR(grad[j], (up - down) / (2.0 * d), tolerance) << "coordinate " << j;
+    EXPECT_NEAR(grad[j], (up - down) / (2.0 * d), relative * std::abs(grad[j]) + floor)
+        << "coordinate " << j;
   }
 }
 

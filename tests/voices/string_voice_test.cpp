@@ -60,17 +60,18 @@ TEST(StringVoice, StrikesConserveEnergyExactly) {
   }
 }
 
-// Mode-1 energy ½(ȧ² + ω² a²) of the string decays as e^{−2σt}; its slope gives the T60.
-double measuredT60(StringVoice& voice, double from, double to) {
+// Mode-`mode` energy ½(ȧ² + ω² a²) of the string decays as e^{−2σt}; its slope gives the T60.
+double measuredT60(StringVoice& voice, double from, double to, int mode = 1) {
   const double k = voice.scheme().parameters().k;
-  const double omega = 2.0 * std::numbers::pi * voice.fundamentalHz();
+  const NonlinearString& string = voice.scheme().system().string();
+  const double omega = 2.0 * std::numbers::pi * schemePartial(string, k, mode);
   const int m = voice.segments();
   std::vector<double> t, logE;
   double time = 0.0;
   play(voice, to, 48000.0, [&] {
     time += 64.0 / 48000.0;
-    const double a = testing::modalAmplitude(voice.scheme().q(), m, 1);
-    const double rate = (testing::modalAmplitude(voice.scheme().qNext(), m, 1) - a) / k;
+    const double a = testing::modalAmplitude(voice.scheme().q(), m, mode);
+    const double rate = (testing::modalAmplitude(voice.scheme().qNext(), m, mode) - a) / k;
     if (time >= from) {
       t.push_back(time);
       logE.push_back(std::log(rate * rate + omega * omega * a * a));
@@ -88,21 +89,76 @@ double measuredT60(StringVoice& voice, double from, double to) {
   return 2.0 * 6.907755278982137 / -slope;
 }
 
-TEST(StringVoice, FundamentalDecaysInThePatchT60) {
+// Both ends of the two-T60 law: the fundamental (σ0 dominates) and the partial nearest the
+// patch's second frequency (σ1 dominates), each within 5 % of σ0 + σ1 ξ_m, with ξ_m = (mπ/L)².
+TEST(StringVoice, PartialsDecayInThePatchT60s) {
   StringPatch patch = piano(48);
   patch.t60Low = 3.0;
-  patch.t60High = 1.0;
+  patch.t60High = 0.5;
   patch.t60HighHz = 2000.0;
+  const double k = 1.0 / 48000.0;
+  for (int mode : {1, 15}) {  // partial 15 of C3 sits at ≈ 2 kHz
+    StringVoice voice;
+    voice.prepare(patch, 48, 48000.0);
+    voice.noteOn(0.5);
+    const StringPhysics& p = voice.scheme().system().string().physics();
+    const StringLoss loss = stringLossFromT60(p, 3.0, 0.5, 2000.0);
+    const double xi = std::pow(mode * std::numbers::pi / p.length, 2);
+    const double expected = 6.907755278982137 / (loss.sigma0 + loss.sigma1 * xi);
+    if (mode == 15) {
+      EXPECT_NEAR(schemePartial(voice.scheme().system().string(), k, mode), 2000.0, 100.0);
+      EXPECT_NEAR(expected, 0.5, 0.05);  // the law's second point, near 2 kHz
+    }
+    EXPECT_NEAR(measuredT60(voice, 0.05, std::min(1.5, 1.5 * expected), mode), expected,
+                0.05 * expected)
+        << "partial " << mode;
+  }
+}
+
+// The voice's own tuning path — two rounds with σ1, oversampling 4 — puts the simulated
+// fundamental on the note.
+TEST(StringVoice, SoundsItsNote) {
+  StringPatch patch = piano(60);
+  patch.oversampling = 4;
   StringVoice voice;
-  voice.prepare(patch, 48, 48000.0);
+  voice.prepare(patch, 60, 48000.0);
+  const double target = equalTemperament(60);
+  EXPECT_NEAR(testing::cents(voice.fundamentalHz(), target), 0.0, 1e-3);
+  voice.noteOn(0.05);  // pianissimo: the pitch glide of a hard strike stays far below 1 cent
+  std::vector<double> mode1;
+  play(voice, 0.3, 48000.0, [&] {});  // let the strike settle
+  std::vector<float> l(1), r(1);
+  for (int n = 0; n < 48000 * 0.5; ++n) {
+    voice.process(l, r);
+    mode1.push_back(testing::modalAmplitude(voice.scheme().q(), voice.segments(), 1));
+  }
+  const double f = testing::zeroCrossingFrequency(mode1, 1.0 / 48000.0);
+  EXPECT_NEAR(testing::cents(f, target), 0.0, 1.0);
+}
+
+TEST(StringVoice, WritesAShortRightChannelAndNothingBeyond) {
+  StringVoice voice;
+  voice.prepare(piano(60), 60, 48000.0);
+  voice.noteOn(0.8);
+  std::vector<float> l(64, 7.0f), r(32, 7.0f);
+  voice.process(l, r);
+  for (float x : r) EXPECT_NE(x, 7.0f);
+  for (float x : l) EXPECT_NE(x, 7.0f);
+}
+
+TEST(StringVoice, FailedPrepareLeavesTheVoiceAsItWas) {
+  StringVoice voice;
+  voice.prepare(piano(60), 60, 48000.0);
+  const int segments = voice.segments();
+  StringPatch bad = piano(60);
+  bad.hammer.mass = -1.0;
+  EXPECT_THROW(voice.prepare(bad, 60, 96000.0), std::invalid_argument);
+  EXPECT_EQ(voice.segments(), segments);
+  EXPECT_EQ(voice.scheme().parameters().k, 1.0 / 48000.0);
   voice.noteOn(0.5);
-  // The law σ0 + σ1 ξ at the fundamental's ξ = (π/L)²: the expected T60 of mode 1.
-  const StringLoss loss =
-      stringLossFromT60(voice.scheme().system().string().physics(), 3.0, 1.0, 2000.0);
-  const double length = voice.scheme().system().string().physics().length;
-  const double expected =
-      6.907755278982137 / (loss.sigma0 + loss.sigma1 * std::pow(std::numbers::pi / length, 2));
-  EXPECT_NEAR(measuredT60(voice, 0.2, 1.5), expected, 0.05 * expected);
+  std::vector<float> l(64), r(64);
+  voice.process(l, r);
+  EXPECT_EQ(voice.guardEvents(), 0);
 }
 
 TEST(StringVoice, DamperShortensTheDecayToItsT60) {
