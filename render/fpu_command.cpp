@@ -34,7 +34,7 @@ CLI::App* addFpuCommand(CLI::App& app, FpuArguments& a) {
   // Numbers are taken as text and parsed strictly by runFpuCommand, whose messages say what
   // is valid.
   auto number = [&](const char* flag, std::string& value, const char* type, const char* what) {
-    fpu->add_option(flag, value, what)->type_name(type)->capture_default_str();
+    addNumberOption(fpu, flag, value, type, what);
   };
   number("--k", a.k, "SECONDS", "time step (> 0)");
   number("--duration", a.duration, "SECONDS", "simulated time (> 0)");

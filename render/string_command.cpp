@@ -35,7 +35,7 @@ CLI::App* addStringCommand(CLI::App& app, StringArguments& a) {
       ->capture_default_str();
   // Numbers are taken as text and parsed strictly by runStringCommand.
   auto number = [&](const char* flag, std::string& value, const char* type, const char* what) {
-    cmd->add_option(flag, value, what)->type_name(type)->capture_default_str();
+    addNumberOption(cmd, flag, value, type, what);
   };
   number("--k", a.k, "SECONDS", "time step (> 0)");
   number("--grid-factor", a.gridFactor, "NUMBER", "multiplies the rule's minimal h (>= 1)");

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "support/energy_checks.h"
 #include "support/fpu_runs.h"
 
 namespace hamiltone {
@@ -47,15 +48,7 @@ double convergenceOrder(MakeScheme make) {
     x.push_back(std::log(k));
     y.push_back(std::log(e));
   }
-  const double n = static_cast<double>(x.size());
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  for (size_t i = 0; i < x.size(); ++i) {
-    sx += x[i];
-    sy += y[i];
-    sxx += x[i] * x[i];
-    sxy += x[i] * y[i];
-  }
-  const double order = (n * sxy - sx * sy) / (n * sxx - sx * sx);
+  const double order = testing::leastSquaresSlope(x, y);
   ::testing::Test::RecordProperty("order", std::to_string(order));
   return order;
 }

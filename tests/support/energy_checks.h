@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include "schemes/hamiltonian.h"
 
@@ -36,6 +37,19 @@ void expectGradientIsDerivative(Potential potential, const Vector& grad, Vector 
     EXPECT_NEAR(grad[j], (up - down) / (2.0 * d), relative * std::abs(grad[j]) + floor)
         << "coordinate " << j;
   }
+}
+
+// Least-squares slope of y against x: a convergence order, or a decay rate.
+inline double leastSquaresSlope(const std::vector<double>& x, const std::vector<double>& y) {
+  const double n = static_cast<double>(x.size());
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  for (size_t i = 0; i < x.size(); ++i) {
+    sx += x[i];
+    sy += y[i];
+    sxx += x[i] * x[i];
+    sxy += x[i] * y[i];
+  }
+  return (n * sxy - sx * sy) / (n * sxx - sx * sx);
 }
 
 struct Balance {

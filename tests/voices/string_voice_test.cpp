@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "presets/piano_scale.h"
+#include "support/energy_checks.h"
 #include "support/modal.h"
 
 namespace hamiltone {
@@ -77,16 +78,7 @@ double measuredT60(StringVoice& voice, double from, double to, int mode = 1) {
       logE.push_back(std::log(rate * rate + omega * omega * a * a));
     }
   });
-  double st = 0, se = 0, stt = 0, ste = 0;
-  const double n = static_cast<double>(t.size());
-  for (size_t i = 0; i < t.size(); ++i) {
-    st += t[i];
-    se += logE[i];
-    stt += t[i] * t[i];
-    ste += t[i] * logE[i];
-  }
-  const double slope = (n * ste - st * se) / (n * stt - st * st);
-  return 2.0 * 6.907755278982137 / -slope;
+  return 2.0 * 6.907755278982137 / -testing::leastSquaresSlope(t, logE);
 }
 
 // Both ends of the two-T60 law: the fundamental (σ0 dominates) and the partial nearest the
