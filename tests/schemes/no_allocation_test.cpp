@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "models/hammer.h"
+#include "models/plate.h"
 #include "presets/piano_scale.h"
 #include "support/fpu_runs.h"
 #include "voices/string_voice.h"
@@ -137,6 +138,14 @@ TEST(NoAllocation, StringVoiceProcess) {
     EXPECT_EQ(forbiddenNews - before, 0);
     EXPECT_EQ(voice.guardEvents(), 0);
   }
+}
+
+// The plate: stencils, the bracket ℓ and the DST Airy solve, with both losses.
+TEST(NoAllocation, SplitSavOnThePlate) {
+  const VonKarmanPlate plate(PlatePhysics{}, 16, 12);
+  SplitSav<VonKarmanPlate> scheme(plate, {.k = 1e-5, .sigma0 = 1.0, .sigma1 = 1e-4},
+                                  {plateFirstMode(plate, 5.0), Vector::Zero(plate.size())});
+  stepWithoutAllocating(scheme);
 }
 
 TEST(NoAllocation, MarazzatoWithEveryQuadrature) {
