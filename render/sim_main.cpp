@@ -6,6 +6,7 @@
 #include <exception>
 
 #include "fpu_command.h"
+#include "plate_command.h"
 #include "string_command.h"
 #include "usage_error.h"
 
@@ -19,6 +20,8 @@ int main(int argc, char** argv) {
   CLI::App* fpuCommand = addFpuCommand(app, fpu);
   StringArguments string;
   CLI::App* stringCommand = addStringCommand(app, string);
+  PlateArguments plate;
+  CLI::App* plateCommand = addPlateCommand(app, plate);
 
   try {
     app.parse(argc, argv);
@@ -34,6 +37,7 @@ int main(int argc, char** argv) {
   try {
     if (fpuCommand->parsed()) return runFpuCommand(fpu);
     if (stringCommand->parsed()) return runStringCommand(string);
+    if (plateCommand->parsed()) return runPlateCommand(plate);
   } catch (const UsageError& e) {
     std::fprintf(stderr, "hamiltone-sim %s: %s\n",
                  app.get_subcommands().front()->get_name().c_str(), e.what());

@@ -261,4 +261,33 @@ TEST_F(SimCli, StringRefusesBadInput) {
   expectRefused("string --out " + (dir_ / "no" / "x.csv").string(), "--out");
 }
 
+TEST_F(SimCli, PlateWritesTheDocumentedCsv) {
+  const Result r = run("plate --duration 1e-4 --out " + csv());
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  std::istringstream text(slurp(csv()));
+  std::string comment;
+  std::getline(text, comment);
+  EXPECT_EQ(comment.rfind("# nx=44 ny=44 hx=0.0111111", 0), 0u) << comment;
+  std::string rest((std::istreambuf_iterator<char>(text)), std::istreambuf_iterator<char>());
+  std::string header;
+  const auto rows = parseRows(rest, header);
+  EXPECT_EQ(header, "t,q,energy,psi");
+  ASSERT_EQ(rows.size(), 11u);
+  for (const auto& row : rows) EXPECT_NEAR(row[2], rows[0][2], 1e-10 * rows[0][2]);  // (41)
+  // (85) at the probe's grid point, x = round(0.3·45) = 14, y = 18 segments in: α = 10.
+  EXPECT_NEAR(rows[0][1],
+              10.0 * 0.002 * std::sin(14.0 * M_PI / 45.0) * std::sin(18.0 * M_PI / 45.0), 1e-15);
+}
+
+TEST_F(SimCli, PlateRefusesBadInput) {
+  const std::string ok = "plate --duration 1e-4 --out " + csv();
+  expectRefused(ok + " --probe 0.3", "--probe");
+  expectRefused(ok + " --probe 0.3,1.5", "--probe");
+  expectRefused(ok + " --poisson 0.6", "poisson");
+  expectRefused(ok + " --thickness 0", "--thickness");
+  expectRefused(ok + " --grid-factor 0.9", "--grid-factor");
+  expectRefused("plate --k 1 --duration 10 --out " + csv(), "(84)");
+  expectRefused(ok + " --scheme sv --alpha 1e200", "--alpha");
+}
+
 }  // namespace
