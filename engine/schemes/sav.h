@@ -41,7 +41,7 @@ class SavScheme {
     const Eigen::Index n = system_.size();
     checkInitialState(start, n);
     if constexpr (splitK) checkStabilityBound();
-    for (Vector* v : {&prev_, &curr_, &next_, &kq_}) v->setZero(n);
+    for (Vector* v : {&prev_, &curr_, &next_, &kq_, &force_, &extra_}) v->setZero(n);
     for (Vector& g : grads_) g.setZero(n);
     // (21); leaves K q^0 in kq_.
     prev_ = start.q;
@@ -57,7 +57,7 @@ class SavScheme {
   // Sherman–Morrison (33), then ψ^{n+½} by (38c). In the paper's naming the members hold
   // q^{n−1} = prev_, q^n = curr_, q^{n+1} = next_ during the step.
   void step() noexcept {
-    if (loss_.any())
+    if (loss_.any() || forced_)
       stepInternal<true>();
     else
       stepInternal<false>();
@@ -81,6 +81,19 @@ class SavScheme {
     params_.sigma0 = sigma0;
     loss_.setSigma0(sigma0);
   }
+
+  // An external force f (N per coordinate) acting through the next steps: M δtt q = … + f, so b
+  // gains k² M⁻¹ f and the energy grows by fᵀ(q^{n+1} − q^{n−1})/2 a step, tallied in supplied()
+  // whatever trackDissipation says: H + dissipated − supplied stays constant.
+  void setForce(Eigen::Index i, double f) noexcept {
+    force_[i] = f;
+    forced_ = true;
+  }
+  void clearForce() noexcept {
+    force_.setZero();
+    forced_ = false;
+  }
+  double supplied() const { return supplied_; }
 
   // Sets coordinate i at levels n and n+1 — a hammer placed and launched, or caught. The caller
   // keeps V' unchanged by it (the coordinate out of contact), so ψ stays consistent; the energy
@@ -145,13 +158,19 @@ class SavScheme {
       }
     }
     const bool onePass = parts == 1 || loaded <= 1;
-    const double twoSigma1K = 2.0 * params_.sigma1 * k;
-    const double* cq = lossy ? loss_.frequencyForce(system_, curr_, prev_).data() : nullptr;
+    // The loss's σ1 term and the external force enter b alike, b −= M⁻¹ extra_ with
+    // extra_ = 2σ1k C(q^n − q^{n−1}) − k² f.
+    const double* cq = nullptr;
+    if constexpr (lossy) {
+      extra_ =
+          (2.0 * params_.sigma1 * k) * loss_.frequencyForce(system_, curr_, prev_) - kk * force_;
+      cq = extra_.data();
+    }
 
     // Pass 1: ∇V'_jᵀ of q^n, q^{n−1}, M⁻¹K q^n, M⁻¹C(q^n − q^{n−1}), and ∇V'_iᵀ M⁻¹ ∇V'_j.
     // With one part loaded the sums are scalars, which GCC keeps in registers; array
     // reductions cost it a third more on the 1000-pair FPU chain.
-    double gq[parts] = {}, gqm[parts] = {}, gMKq[parts] = {}, gMCq[parts] = {};
+    double gq[parts] = {}, gqm[parts] = {}, gMKq[parts] = {}, gMCq[parts] = {};  // gMCq: of extra_
     double gMg[parts * parts] = {};
     if (onePass) {
       const int a = onlyLoaded;
@@ -193,7 +212,7 @@ class SavScheme {
       for (int b = a; b < parts; ++b) vtu(a, b) = vtu(b, a) = h[a] * h[b] * gMg[a * parts + b];
     }
     for (int a = 0; a < parts; ++a) {
-      double gb = 2.0 * gq[a] - down * gqm[a] - kk * gMKq[a] - twoSigma1K * gMCq[a];
+      double gb = 2.0 * gq[a] - down * gqm[a] - kk * gMKq[a] - gMCq[a];
       for (int b = 0; b < parts; ++b)
         gb += bLinear[b] * h[b] * gMg[std::min(a, b) * parts + std::max(a, b)];
       vtb[a] = h[a] * gb;
@@ -207,7 +226,7 @@ class SavScheme {
     auto newPosition = [&](Eigen::Index i, double correction) {
       double b = 2.0 * q[i] - down * qm[i];
       if constexpr (splitK) b -= kk * (minv[i] * kq[i]);
-      if constexpr (lossy) b -= twoSigma1K * (minv[i] * cq[i]);
+      if constexpr (lossy) b -= minv[i] * cq[i];
       return qp[i] = (b + correction) * invUp;
     };
     double gdq[parts] = {};
@@ -233,6 +252,7 @@ class SavScheme {
     if constexpr (lossy) {
       if (params_.trackDissipation)
         dissipated_ += loss_.dissipation(system_, next_, prev_);  // (50)
+      if (forced_) supplied_ += 0.5 * force_.dot(next_ - prev_);  // the work of f over the step
     }
 
     prev_.swap(curr_);
@@ -281,6 +301,10 @@ class SavScheme {
   std::array<Vector, parts> grads_;  // ∇V'_j (∇V for (27)) at the newest level a step used
   Vector kq_;                        // and K q there
   std::array<double, parts> psi_{};  // ψ_j^{n+½}
+  Vector force_;                     // external force f, N per coordinate
+  Vector extra_;  // 2σ1k C(q^n − q^{n−1}) − k² f: what b loses through M⁻¹
+  bool forced_ = false;
+  double supplied_ = 0.0;  // work of f since the start
   double dissipated_ = 0.0;
   long n_ = 0;
 };

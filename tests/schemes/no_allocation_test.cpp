@@ -13,6 +13,7 @@
 #include "models/plate.h"
 #include "presets/piano_scale.h"
 #include "support/fpu_runs.h"
+#include "voices/plate_voice.h"
 #include "voices/string_voice.h"
 
 namespace {
@@ -146,6 +147,24 @@ TEST(NoAllocation, SplitSavOnThePlate) {
   SplitSav<VonKarmanPlate> scheme(plate, {.k = 1e-5, .sigma0 = 1.0, .sigma1 = 1e-4},
                                   {plateFirstMode(plate, 5.0), Vector::Zero(plate.size())});
   stepWithoutAllocating(scheme);
+}
+
+// The plate voice's audio path: the force pulse, steps, pickups, decimation, guard, damper.
+TEST(NoAllocation, PlateVoiceProcess) {
+  PlateVoice voice;
+  voice.prepare(PlatePatch{}, 60, 48000.0);
+  std::vector<float> left(128), right(128);
+  const long before = forbiddenNews;
+  forbidAllocation(true);
+  voice.noteOn(0.8);
+  for (int block = 0; block < 40; ++block) {
+    if (block == 30) voice.release();
+    voice.process(left, right);
+  }
+  voice.reset();
+  forbidAllocation(false);
+  EXPECT_EQ(forbiddenNews - before, 0);
+  EXPECT_EQ(voice.guardEvents(), 0);
 }
 
 TEST(NoAllocation, MarazzatoWithEveryQuadrature) {

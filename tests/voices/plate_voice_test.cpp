@@ -1,0 +1,110 @@
+// The plate voice: strikes at every velocity and common rate give finite sound and an energy that
+// is exactly the strike's work (lossless), harder strikes are louder, and the note sets the size.
+#include "voices/plate_voice.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "support/modal.h"
+
+namespace hamiltone {
+namespace {
+
+PlatePatch lossless() {
+  PlatePatch p;
+  p.t60Low = p.t60High = INFINITY;
+  return p;
+}
+
+// Plays `seconds`; returns the peak |sample| and whether every sample was finite.
+std::pair<double, bool> play(PlateVoice& voice, double seconds, double rate, auto each) {
+  std::vector<float> l(64), r(64);
+  double peak = 0.0;
+  bool finite = true;
+  for (long n = 0; n < std::lround(seconds * rate / 64); ++n) {
+    voice.process(l, r);
+    for (size_t i = 0; i < l.size(); ++i) {
+      finite = finite && std::isfinite(l[i]) && std::isfinite(r[i]);
+      peak = std::max({peak, std::abs(double(l[i])), std::abs(double(r[i]))});
+    }
+    each();
+  }
+  return {peak, finite};
+}
+
+// Lossless, from rest: H^{n+½} equals the work the force pulse has done, step by step, to
+// roundoff over ~1e4 steps of ~900 unknowns.
+TEST(PlateVoice, StrikesConserveEnergyWithTheInputAccounted) {
+  for (double rate : {44100.0, 48000.0, 96000.0}) {
+    for (int velocity : {1, 64, 127}) {
+      PlateVoice voice;
+      voice.prepare(lossless(), 48, rate);
+      voice.noteOn(velocity / 127.0);
+      double worst = 0.0;
+      const auto [peak, finite] = play(voice, 0.1, rate, [&] {
+        worst = std::max(
+            worst, std::abs(voice.energy() - voice.suppliedEnergy()) / voice.suppliedEnergy());
+      });
+      EXPECT_TRUE(finite) << velocity << " at " << rate;
+      EXPECT_GT(peak, 0.0);
+      EXPECT_LE(worst, 1e-10) << velocity << " at " << rate;
+      EXPECT_EQ(voice.guardEvents(), 0);
+    }
+  }
+}
+
+TEST(PlateVoice, HarderIsLouder) {
+  auto peak = [](double velocity) {
+    PlateVoice voice;
+    voice.prepare(PlatePatch{}, 48, 48000.0);
+    voice.noteOn(velocity);
+    return play(voice, 0.05, 48000.0, [] {}).first;
+  };
+  const double soft = peak(0.2), loud = peak(1.0);
+  EXPECT_GT(loud, 4.0 * soft);  // force ∝ v^1.5: 11× the force, and a shorter, brighter pulse
+}
+
+// Frequencies go as 1/L²: an octave up halves L² and doubles the lowest mode (to the grid's
+// dispersion, which changes with the grid).
+TEST(PlateVoice, NoteSetsTheSize) {
+  PlateVoice low, high;
+  low.prepare(PlatePatch{}, 48, 48000.0);
+  high.prepare(PlatePatch{}, 60, 48000.0);
+  EXPECT_NEAR(high.lowestModeHz() / low.lowestModeHz(), 2.0, 0.05);
+  PlateVoice outside;
+  EXPECT_THROW(outside.prepare(PlatePatch{}, 100, 48000.0), std::invalid_argument);
+}
+
+TEST(PlateVoice, ReleaseDampsAndFreesTheVoice) {
+  PlatePatch patch;
+  patch.damperT60 = 0.2;
+  PlateVoice voice;
+  voice.prepare(patch, 60, 48000.0);
+  voice.noteOn(0.8);
+  play(voice, 0.05, 48000.0, [] {});
+  voice.release();
+  play(voice, 2.0, 48000.0, [] {});
+  EXPECT_FALSE(voice.active());
+}
+
+TEST(PlateVoice, RefusesAnInvalidPatch) {
+  PlateVoice voice;
+  auto with = [](auto change) {
+    PlatePatch p;
+    change(p);
+    return p;
+  };
+  EXPECT_THROW(voice.prepare(with([](auto& p) { p.oversampling = 3; }), 48, 48000),
+               std::invalid_argument);
+  EXPECT_THROW(voice.prepare(with([](auto& p) { p.strike[0] = 1.2; }), 48, 48000),
+               std::invalid_argument);
+  EXPECT_THROW(voice.prepare(with([](auto& p) { p.durationMin = 0.0; }), 48, 48000),
+               std::invalid_argument);
+  EXPECT_THROW(voice.prepare(with([](auto& p) { p.t60High = 20.0; }), 48, 48000),
+               std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace hamiltone
