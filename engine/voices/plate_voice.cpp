@@ -47,6 +47,8 @@ void PlateVoice::prepare(const PlatePatch& patch, int midiNote, double sampleRat
           "within the patch's lowest_note … highest_note, " + std::to_string(patch.lowestNote) +
               " … " + std::to_string(patch.highestNote));
   for (double f : patch.strike) require(f > 0.0 && f < 1.0, "strike_position", f, "in (0, 1)");
+  for (double f : patch.strikeHigh)
+    require(f > 0.0 && f < 1.0, "strike_position_high", f, "in (0, 1)");
   for (const auto& p : patch.pickups)
     for (double f : p) require(f > 0.0 && f < 1.0, "pickup_position", f, "in (0, 1)");
   require(std::isfinite(patch.strikeWidth) && patch.strikeWidth >= 0.0, "strike_width_m",
@@ -63,11 +65,21 @@ void PlateVoice::prepare(const PlatePatch& patch, int midiNote, double sampleRat
   require(patch.guardEnergyMultiple > 1.0, "guard_energy_multiple", patch.guardEnergyMultiple,
           "> 1");
 
-  // Frequencies go as 1/L²: a semitone up shrinks both sides by 2^(−1/24).
+  // Frequencies go as 1/L²: a semitone up shrinks both sides by 2^(−1/24). Or, per patch, the
+  // plate keeps its size and the note moves the strike point between its two positions.
   PlatePhysics physics = patch.plate;
-  const double scale = std::pow(2.0, -(midiNote - patch.referenceNote) / 24.0);
-  physics.lx *= scale;
-  physics.ly *= scale;
+  double strike[2] = {patch.strike[0], patch.strike[1]};
+  if (patch.noteMovesStrike) {
+    const double t =
+        patch.highestNote == patch.lowestNote
+            ? 0.0
+            : double(midiNote - patch.lowestNote) / (patch.highestNote - patch.lowestNote);
+    for (int c = 0; c < 2; ++c) strike[c] += t * (patch.strikeHigh[c] - strike[c]);
+  } else {
+    const double scale = std::pow(2.0, -(midiNote - patch.referenceNote) / 24.0);
+    physics.lx *= scale;
+    physics.ly *= scale;
+  }
   const double k = 1.0 / (sampleRate * r);
   const PlateLoss loss = plateLossFromT60(physics, patch.t60Low, patch.t60High, patch.t60HighHz);
   const VonKarmanPlate plate(physics, plateSegments(physics, physics.lx, k, patch.gridFactor),
@@ -81,7 +93,7 @@ void PlateVoice::prepare(const PlatePatch& patch, int midiNote, double sampleRat
   // The strike spread: a raised cone over the points within width/2, or the nearest point.
   std::vector<Eigen::Index> index;
   std::vector<double> weight;
-  const double x0 = patch.strike[0] * physics.lx, y0 = patch.strike[1] * physics.ly;
+  const double x0 = strike[0] * physics.lx, y0 = strike[1] * physics.ly;
   double total = 0.0, nearest = INFINITY;
   Eigen::Index nearestIndex = 0;
   for (int m = 0; m < plate.ny(); ++m)
@@ -101,6 +113,7 @@ void PlateVoice::prepare(const PlatePatch& patch, int midiNote, double sampleRat
   for (Decimator& d : decimators) d.prepare(r);
 
   patch_ = patch;
+  for (DcBlocker& b : dcBlockers_) b.prepare(5.0, sampleRate);
   sampleRate_ = sampleRate;
   k_ = k;
   loss_ = loss;
@@ -119,6 +132,7 @@ void PlateVoice::prepare(const PlatePatch& patch, int midiNote, double sampleRat
 void PlateVoice::reset() noexcept {
   *scheme_ = *atRest_;
   for (Decimator& d : decimators_) d.reset();
+  for (DcBlocker& b : dcBlockers_) b.reset();
   pulsing_ = active_ = released_ = false;
   quietTime_ = 0.0;
 }
@@ -144,7 +158,7 @@ void PlateVoice::release() noexcept {
   scheme_->setSigma0(loss_.sigma0 + kLn1000 / patch_.damperT60);
 }
 
-// Velocity (q^{n+1} − q^n)/k, bilinear between the four grid points around (x, y).
+// Velocity (q^{n+1} − q^n)/k or displacement q^n, bilinear between the grid points around (x, y).
 double PlateVoice::pickup(const Vector& q, const Vector& qNext, const double* at) const {
   const VonKarmanPlate& plate = scheme_->system();
   const double sx = std::clamp(at[0] * (plate.nx() + 1) - 1.0, 0.0, plate.nx() - 1.0);
@@ -155,7 +169,7 @@ double PlateVoice::pickup(const Vector& q, const Vector& qNext, const double* at
   const double fx = sx - l, fy = sy - m;
   auto value = [&](int a, int b) {
     const Eigen::Index i = a + static_cast<Eigen::Index>(plate.nx()) * b;
-    return (qNext[i] - q[i]) / k_;
+    return patch_.signal == PickupSignal::displacement ? q[i] : (qNext[i] - q[i]) / k_;
   };
   return (1.0 - fy) * ((1.0 - fx) * value(l, m) + fx * value(l1, m)) +
          fy * ((1.0 - fx) * value(l, m1) + fx * value(l1, m1));
@@ -190,6 +204,8 @@ void PlateVoice::process(std::span<float> left, std::span<float> right) noexcept
         ready =
             decimators_[c].push(pickup(scheme_->q(), scheme_->qNext(), patch_.pickups[c]), out[c]);
     }
+    if (patch_.signal == PickupSignal::displacement)
+      for (int c = 0; c < 2; ++c) out[c] = dcBlockers_[c].process(out[c]);
     left[i] = static_cast<float>(patch_.gain * out[0]);
     finite = finite && std::isfinite(left[i]);
     if (i < rightCount) {

@@ -9,6 +9,7 @@
 #include "models/plate.h"
 #include "schemes/sav.h"
 #include "voices/decimator.h"
+#include "voices/pickup.h"
 
 namespace hamiltone {
 
@@ -26,8 +27,12 @@ struct PlatePatch {
   double forceMax = 300.0;                                 // N, peak force at velocity 1
   double durationMin = 0.5e-3, durationMax = 3e-3;         // s, pulse at velocity 1 and 0
   double velocityCurve = 1.5;                              // force = max · v^curve
-  double pickups[2][2] = {{0.23, 0.31}, {0.71, 0.62}};     // (x, y) fractions, left and right
-  double gain = 0.5;                                       // output units per m/s
+  // The note can instead move the strike point: from strike to strikeHigh across the notes.
+  bool noteMovesStrike = false;
+  double strikeHigh[2] = {0.5, 0.5};
+  double pickups[2][2] = {{0.23, 0.31}, {0.71, 0.62}};  // (x, y) fractions, left and right
+  PickupSignal signal = PickupSignal::velocity;         // displacement is DC-blocked at 5 Hz
+  double gain = 0.5;                                    // output units per m/s (or per m)
   double guardEnergyMultiple = 4.0;
 };
 
@@ -63,6 +68,7 @@ class PlateVoice {
   PlatePatch patch_;
   std::unique_ptr<SplitSav<VonKarmanPlate>> scheme_, atRest_;
   Decimator decimators_[2];
+  DcBlocker dcBlockers_[2];
   std::vector<Eigen::Index> strikeIndex_;
   std::vector<double> strikeWeight_;
   PlateLoss loss_;

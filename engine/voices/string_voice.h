@@ -9,10 +9,9 @@
 #include "models/string_tuning.h"
 #include "schemes/sav.h"
 #include "voices/decimator.h"
+#include "voices/pickup.h"
 
 namespace hamiltone {
-
-enum class PickupSignal { velocity, displacement };
 
 // The sound: everything a preset sets for one string voice.
 struct StringPatch {

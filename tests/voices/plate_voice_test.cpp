@@ -77,6 +77,43 @@ TEST(PlateVoice, NoteSetsTheSize) {
   EXPECT_THROW(outside.prepare(PlatePatch{}, 100, 48000.0), std::invalid_argument);
 }
 
+// Per patch, the note moves the strike point instead: same plate, same modes, another sound.
+TEST(PlateVoice, NoteCanMoveTheStrikeInstead) {
+  PlatePatch patch;
+  patch.noteMovesStrike = true;
+  PlateVoice low, high;
+  low.prepare(patch, patch.lowestNote, 48000.0);
+  high.prepare(patch, patch.highestNote, 48000.0);
+  EXPECT_EQ(low.lowestModeHz(), high.lowestModeHz());
+  std::vector<float> l1(256), r1(256), l2(256), r2(256);
+  low.noteOn(0.8);
+  high.noteOn(0.8);
+  low.process(l1, r1);
+  high.process(l2, r2);
+  EXPECT_NE(l1, l2);
+}
+
+// A displacement pickup is DC-blocked: after a strike the output averages to zero.
+TEST(PlateVoice, DisplacementPickupIsDcFree) {
+  PlatePatch patch;
+  patch.signal = PickupSignal::displacement;
+  patch.gain = 1000.0;
+  PlateVoice voice;
+  voice.prepare(patch, 48, 48000.0);
+  voice.noteOn(1.0);
+  std::vector<float> l(48000), r(48000);
+  voice.process(l, r);
+  double mean = 0.0, rms = 0.0;
+  for (size_t i = 24000; i < l.size(); ++i) {
+    mean += l[i];
+    rms += double(l[i]) * l[i];
+  }
+  mean /= 24000.0;
+  rms = std::sqrt(rms / 24000.0);
+  EXPECT_GT(rms, 0.0);
+  EXPECT_LT(std::abs(mean), 0.05 * rms);
+}
+
 TEST(PlateVoice, ReleaseDampsAndFreesTheVoice) {
   PlatePatch patch;
   patch.damperT60 = 0.2;
