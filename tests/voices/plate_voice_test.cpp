@@ -126,6 +126,20 @@ TEST(PlateVoice, ReleaseDampsAndFreesTheVoice) {
   EXPECT_FALSE(voice.active());
 }
 
+// A strike of 1e200 N overflows the state: the guard silences the block, resets and counts it.
+TEST(PlateVoice, GuardSilencesANonFiniteState) {
+  PlatePatch patch;
+  patch.forceMax = 1e200;
+  PlateVoice voice;
+  voice.prepare(patch, 48, 48000.0);
+  voice.noteOn(1.0);
+  std::vector<float> l(64, 1.0f), r(64, 1.0f);
+  for (int block = 0; block < 20 && voice.guardEvents() == 0; ++block) voice.process(l, r);
+  EXPECT_EQ(voice.guardEvents(), 1);
+  for (float x : l) EXPECT_EQ(x, 0.0f);
+  EXPECT_FALSE(voice.active());
+}
+
 TEST(PlateVoice, RefusesAnInvalidPatch) {
   PlateVoice voice;
   auto with = [](auto change) {
