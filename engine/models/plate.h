@@ -70,6 +70,7 @@ class VonKarmanPlate {
   mutable Vector airy_, work_, lap_;
   mutable Eigen::MatrixXd spectral_;  // nx × ny scratch of the transforms
   mutable Eigen::MatrixXd half_;
+  mutable Vector padF_, padG_, cellF_, cellG_;  // the bracket's zero-padded arrays and cells
 };
 
 // Initial condition (85): q = α ξ sin(πx/Lx) sin(πy/Ly).

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <new>
 #include <numbers>
+#include <tuple>
 #include <vector>
 
 #include "models/hammer.h"
@@ -141,12 +142,21 @@ TEST(NoAllocation, StringVoiceProcess) {
   }
 }
 
-// The plate: stencils, the bracket ℓ and the DST Airy solve, with both losses.
+// The plate: stencils, the bracket ℓ and the DST Airy solve (Eigen's blocked products), with
+// both losses, from a small grid to the 87 × 69 points of a 1 m × 0.8 m, 1 mm plate at 48 kHz.
 TEST(NoAllocation, SplitSavOnThePlate) {
-  const VonKarmanPlate plate(PlatePhysics{}, 16, 12);
-  SplitSav<VonKarmanPlate> scheme(plate, {.k = 1e-5, .sigma0 = 1.0, .sigma1 = 1e-4},
-                                  {plateFirstMode(plate, 5.0), Vector::Zero(plate.size())});
-  stepWithoutAllocating(scheme);
+  PlatePhysics large;
+  large.lx = 1.0;
+  large.ly = 0.8;
+  large.thickness = 1e-3;
+  for (const auto& [physics, mx, my] :
+       {std::tuple{PlatePhysics{}, 16, 12}, std::tuple{PlatePhysics{}, 31, 31},
+        std::tuple{large, 88, 70}}) {
+    const VonKarmanPlate plate(physics, mx, my);
+    SplitSav<VonKarmanPlate> scheme(plate, {.k = 1e-5, .sigma0 = 1.0, .sigma1 = 1e-4},
+                                    {plateFirstMode(plate, 0.1), Vector::Zero(plate.size())});
+    stepWithoutAllocating(scheme);
+  }
 }
 
 // The plate voice's audio path: the force pulse, steps, pickups, decimation, guard, damper.
