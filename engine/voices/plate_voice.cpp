@@ -9,6 +9,7 @@
 #include <string>
 
 #include "util/format_number.h"
+#include "voices/voice_block.h"
 
 namespace hamiltone {
 
@@ -134,7 +135,7 @@ void PlateVoice::reset() noexcept {
   for (Decimator& d : decimators_) d.reset();
   for (DcBlocker& b : dcBlockers_) b.reset();
   pulsing_ = active_ = released_ = false;
-  quietTime_ = 0.0;
+  quiet_.reset();
 }
 
 double PlateVoice::energy() const { return scheme_->energy().total(); }
@@ -178,8 +179,7 @@ double PlateVoice::pickup(const Vector& q, const Vector& qNext, const double* at
 void PlateVoice::process(std::span<float> left, std::span<float> right) noexcept {
   const size_t rightCount = std::min(left.size(), right.size());
   if (!active_) {
-    std::fill(left.begin(), left.end(), 0.0f);
-    std::fill(right.begin(), right.begin() + rightCount, 0.0f);
+    silence(left, right, rightCount);
     return;
   }
   bool finite = true;
@@ -217,16 +217,14 @@ void PlateVoice::process(std::span<float> left, std::span<float> right) noexcept
   const Energy e = scheme_->energy();
   if (!finite || !std::isfinite(e.total()) ||
       e.total() > patch_.guardEnergyMultiple * std::max(scheme_->supplied(), 1e-12)) {
-    std::fill(left.begin(), left.end(), 0.0f);
-    std::fill(right.begin(), right.begin() + rightCount, 0.0f);
+    silence(left, right, rightCount);
     ++guardEvents_;
     reset();
     return;
   }
-  quietTime_ = released_ && e.kinetic < 1e-12 * scheme_->supplied()
-                   ? quietTime_ + static_cast<double>(left.size()) / sampleRate_
-                   : 0.0;
-  if (quietTime_ > 0.05) active_ = false;
+  if (quiet_.update(released_, e.kinetic, scheme_->supplied(),
+                    static_cast<double>(left.size()) / sampleRate_))
+    active_ = false;
 }
 
 }  // namespace hamiltone

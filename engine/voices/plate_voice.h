@@ -10,6 +10,7 @@
 #include "schemes/sav.h"
 #include "voices/decimator.h"
 #include "voices/pickup.h"
+#include "voices/voice_block.h"
 
 namespace hamiltone {
 
@@ -68,13 +69,13 @@ class PlateVoice {
   PlatePatch patch_;
   std::unique_ptr<SplitSav<VonKarmanPlate>> scheme_, atRest_;
   Decimator decimators_[2];
+  QuietDetector quiet_;
   DcBlocker dcBlockers_[2];
   std::vector<Eigen::Index> strikeIndex_;
   std::vector<double> strikeWeight_;
   PlateLoss loss_;
   double sampleRate_ = 0.0, k_ = 0.0, lowestMode_ = 0.0;
   double pulseTime_ = 0.0, pulseDuration_ = 0.0, pulseForce_ = 0.0;
-  double quietTime_ = 0.0;
   int guardEvents_ = 0;
   bool active_ = false, released_ = false, pulsing_ = false;
 };

@@ -10,6 +10,7 @@
 
 #include "presets/piano_scale.h"
 #include "util/format_number.h"
+#include "voices/voice_block.h"
 
 namespace hamiltone {
 
@@ -117,7 +118,7 @@ void StringVoice::reset() noexcept {
   for (Decimator& d : decimators_) d.reset();
   injected_ = caught_ = 0.0;
   separatedSteps_ = 0;
-  quietTime_ = 0.0;
+  quiet_.reset();
   active_ = released_ = struck_ = false;
 }
 
@@ -200,8 +201,7 @@ void StringVoice::process(std::span<float> left, std::span<float> right) noexcep
   const bool stereo = patch_.channels == 2 && !right.empty();
   const size_t rightCount = stereo ? std::min(left.size(), right.size()) : 0;
   if (!active_) {
-    std::fill(left.begin(), left.end(), 0.0f);
-    std::fill(right.begin(), right.begin() + rightCount, 0.0f);
+    silence(left, right, rightCount);
     return;
   }
   bool finite = true;
@@ -227,19 +227,14 @@ void StringVoice::process(std::span<float> left, std::span<float> right) noexcep
   const Energy e = scheme_->energy();
   const double h = e.total();
   if (!finite || !std::isfinite(h) || h > patch_.guardEnergyMultiple * injected_) {
-    std::fill(left.begin(), left.end(), 0.0f);
-    std::fill(right.begin(), right.begin() + rightCount, 0.0f);
+    silence(left, right, rightCount);
     ++guardEvents_;
     reset();
     return;
   }
-  // Released and silent — its kinetic energy 120 dB under the strike's for 50 ms, longer than
-  // the lowest string's half period — the voice is free. Kinetic, not total: on the transverse
-  // grid the SAV can leave a static longitudinal stretch that holds potential but sounds nothing.
-  quietTime_ = released_ && e.kinetic < 1e-12 * injected_
-                   ? quietTime_ + static_cast<double>(left.size()) / sampleRate_
-                   : 0.0;
-  if (quietTime_ > 0.05) active_ = false;
+  if (quiet_.update(released_, e.kinetic, injected_,
+                    static_cast<double>(left.size()) / sampleRate_))
+    active_ = false;
 }
 
 }  // namespace hamiltone

@@ -10,6 +10,7 @@
 #include "schemes/sav.h"
 #include "voices/decimator.h"
 #include "voices/pickup.h"
+#include "voices/voice_block.h"
 
 namespace hamiltone {
 
@@ -78,9 +79,10 @@ class StringVoice {
   std::unique_ptr<SplitSav<HammeredString>> scheme_;
   std::unique_ptr<SplitSav<HammeredString>> atRest_;  // the reset state, copied in reset()
   Decimator decimators_[2];
+  QuietDetector quiet_;
   StringLoss loss_;
   double sampleRate_ = 0.0, k_ = 0.0, fundamental_ = 0.0;
-  double injected_ = 0.0, caught_ = 0.0, quietTime_ = 0.0;
+  double injected_ = 0.0, caught_ = 0.0;
   int guardEvents_ = 0;
   int separatedSteps_ = 0;
   bool active_ = false, released_ = false, struck_ = false;
