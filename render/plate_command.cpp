@@ -110,8 +110,8 @@ int runPlateCommand(const PlateArguments& a) {
   const long steps = stepCount(duration, k);
   checkOutputSize(steps, every, 4);
 
-  const int mx = building([&] { return plateSegments(physics, physics.lx, k, factor); });
-  const int my = building([&] { return plateSegments(physics, physics.ly, k, factor); });
+  const int mx = building([&] { return plateSegments(physics, physics.lx, k, factor, sigma1); });
+  const int my = building([&] { return plateSegments(physics, physics.ly, k, factor, sigma1); });
   const VonKarmanPlate plate = building([&] { return VonKarmanPlate(physics, mx, my); });
   const long l = std::clamp(std::lround(px * mx) - 1, 0L, static_cast<long>(plate.nx() - 1));
   const long m = std::clamp(std::lround(py * my) - 1, 0L, static_cast<long>(plate.ny() - 1));

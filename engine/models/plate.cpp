@@ -180,11 +180,13 @@ Vector plateFirstMode(const VonKarmanPlate& plate, double alpha) {
   return q;
 }
 
-int plateSegments(const PlatePhysics& p, double length, double k, double factor) {
+int plateSegments(const PlatePhysics& p, double length, double k, double factor, double sigma1) {
   if (!(factor >= 1.0) || !std::isfinite(factor))
     throw std::invalid_argument("grid factor = " + formatNumber(factor) + ": must be >= 1");
-  const double h =
-      factor * 2.0 * std::sqrt(k) * std::pow(p.rigidity() / (p.density * p.thickness), 0.25);
+  const double kappa = std::sqrt(p.rigidity() / (p.density * p.thickness));
+  const double a = 16.0 * k * k * kappa * kappa, b = 8.0 * sigma1 * k;
+  const double xMax = (-b + std::sqrt(b * b + 4.0 * a)) / (2.0 * a);  // the largest 1/h²
+  const double h = factor / std::sqrt(xMax);
   const double segments = std::floor(length / h);
   if (!(segments >= 2.0))
     throw std::invalid_argument("plate side " + formatNumber(length) +

@@ -76,7 +76,10 @@ class VonKarmanPlate {
 // Initial condition (85): q = α ξ sin(πx/Lx) sin(πy/Ly).
 Vector plateFirstMode(const VonKarmanPlate& plate, double alpha);
 
-// Segments along a side of `length` from the bound (84), h >= 2 sqrt(k) (D/ρξ)^¼, times `factor`.
-int plateSegments(const PlatePhysics& physics, double length, double k, double factor);
+// Segments along a side of `length` from the bound (84), h >= 2 sqrt(k) (D/ρξ)^¼, times
+// `factor` — tightened for a loss σ1 as maxStableStep is: with x = 1/h² and −DΔ <= 8x on a
+// square grid, 16 k²κ² x² + 8 σ1 k x <= 1, κ² = D/ρξ.
+int plateSegments(const PlatePhysics& physics, double length, double k, double factor,
+                  double sigma1 = 0.0);
 
 }  // namespace hamiltone

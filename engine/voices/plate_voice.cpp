@@ -16,6 +16,7 @@ namespace hamiltone {
 namespace {
 
 constexpr double kLn1000 = 6.907755278982137;  // T60 = ln(1000) / σ
+constexpr int kMaxPoints = 120;                // per side, allocation-free (see prepare)
 
 void require(bool ok, const char* field, double value, const std::string& valid) {
   if (!ok)
@@ -83,8 +84,17 @@ void PlateVoice::prepare(const PlatePatch& patch, int midiNote, double sampleRat
   }
   const double k = 1.0 / (sampleRate * r);
   const PlateLoss loss = plateLossFromT60(physics, patch.t60Low, patch.t60High, patch.t60HighHz);
-  const VonKarmanPlate plate(physics, plateSegments(physics, physics.lx, k, patch.gridFactor),
-                             plateSegments(physics, physics.ly, k, patch.gridFactor));
+  require((loss.sigma0 + kLn1000 / patch.damperT60) * k < 1.0, "damper_t60_s", patch.damperT60,
+          "longer than ln(1000) k / (1 − σ0 k) = " +
+              formatNumber(kLn1000 * k / (1.0 - loss.sigma0 * k)) + " s at this rate");
+  const int mx = plateSegments(physics, physics.lx, k, patch.gridFactor, loss.sigma1);
+  const int my = plateSegments(physics, physics.ly, k, patch.gridFactor, loss.sigma1);
+  // Eigen's blocked products of the Airy solve keep their buffers on the stack up to about
+  // 120 points a side (measured: 130 allocates); the audio path must not allocate.
+  require(std::max(mx, my) - 1 <= kMaxPoints, "grid points per side", std::max(mx, my) - 1,
+          "at most " + std::to_string(kMaxPoints) +
+              " for this note: lower oversampling or raise grid_factor");
+  const VonKarmanPlate plate(physics, mx, my);
   const StepParameters params{
       .k = k, .sigma0 = loss.sigma0, .sigma1 = loss.sigma1, .trackDissipation = false};
   auto scheme = std::make_unique<SplitSav<VonKarmanPlate>>(

@@ -89,6 +89,9 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
     tuned = tuneString(patch.string, patch.tuneBy, patch.grid, k, loss.sigma1, patch.gridFactor,
                        target);
   }
+  require((loss.sigma0 + kLn1000 / patch.damperT60) * k < 1.0, "damper_t60_s", patch.damperT60,
+          "longer than ln(1000) k / (1 − σ0 k) = " +
+              formatNumber(kLn1000 * k / (1.0 - loss.sigma0 * k)) + " s at this rate");
   const HammeredString system(NonlinearString(tuned.physics, tuned.segments), patch.hammer);
   InitialState rest{Vector::Zero(system.size()), Vector::Zero(system.size())};
   rest.q[system.hammerIndex()] = kParkedAt;
