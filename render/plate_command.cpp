@@ -46,7 +46,7 @@ CLI::App* addPlateCommand(CLI::App& app, PlateArguments& a) {
       ->type_name("PATH")
       ->required();
   cmd->footer(
-      "CSV: a comment line '# nx=.. ny=.. hx=.. hy=.. k=..' (interior points and spacings), a\n"
+      "CSV: a comment line '# nx=.. ny=.. h=.. hy=.. k=..' (interior points; h along x), a\n"
       "  header, then one row per written step n: t,q,energy,psi. t = n k; q = q^n at the grid\n"
       "  point nearest the probe; energy = H^{n+1/2} of (41) (sv: (41) with ψ = 0 plus\n"
       "  V'(q^n)); psi = ψ^{n+1/2} (0 for sv). With loss, energy + dissipated is what stays\n"
@@ -120,7 +120,7 @@ int runPlateCommand(const PlateArguments& a) {
   const InitialState start{plateFirstMode(plate, alpha), Vector::Zero(plate.size())};
 
   AtomicFile file(a.out, "--out");
-  std::fprintf(file.stream(), "# nx=%d ny=%d hx=%.17g hy=%.17g k=%.17g\n", plate.nx(), plate.ny(),
+  std::fprintf(file.stream(), "# nx=%d ny=%d h=%.17g hy=%.17g k=%.17g\n", plate.nx(), plate.ny(),
                plate.hx(), plate.hy(), k);
   const RunSummary summary =
       a.scheme == "sv"

@@ -267,7 +267,7 @@ TEST_F(SimCli, PlateWritesTheDocumentedCsv) {
   std::istringstream text(slurp(csv()));
   std::string comment;
   std::getline(text, comment);
-  EXPECT_EQ(comment.rfind("# nx=44 ny=44 hx=0.0111111", 0), 0u) << comment;
+  EXPECT_EQ(comment.rfind("# nx=44 ny=44 h=0.0111111", 0), 0u) << comment;
   std::string rest((std::istreambuf_iterator<char>(text)), std::istreambuf_iterator<char>());
   std::string header;
   const auto rows = parseRows(rest, header);
