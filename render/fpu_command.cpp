@@ -45,19 +45,15 @@ CLI::App* addFpuCommand(CLI::App& app, FpuArguments& a) {
   number("--sigma0", a.sigma0, "1/S",
          "mass-proportional loss σ0, force −2σ0 M q' (>= 0; sv, sav, sav-split)");
   number("--every", a.every, "INT", "write every N-th step (>= 1); n = 0 is always written");
-  fpu->add_option("--out", a.out, "CSV file to write (replaced whole, or left untouched on error)")
-      ->type_name("PATH")
-      ->required();
+  addOutputOption(fpu, a.out);
   fpu->footer(
       "CSV: a header, then one row per written step n: t,q1..qN,energy,kinetic,potential.\n"
       "  t = n k and q = q^n. For sv, sav, sav-split the energy is that of the interval\n"
       "  [t^n, t^{n+1}]: H^{n+1/2} of (41) [(36) for sav], kinetic = ½|q^{n+1}−q^n|²/k²,\n"
       "  potential = ½ q^{n+1}·K q^n + ½ψ² − ε (sv: ψ = 0 plus V'(q^n)). For marazzato it is\n"
       "  the pseudo-energy (13) at t^n: kinetic = ½ p^{n−½}·p^{n+½}, potential = V(q^n).\n"
-      "  With loss, energy + dissipated energy is what stays constant (50).\n"
-      "Steps: floor(duration / k); the last row is at t = steps · k.\n"
-      "Exit codes: 0 done (a scheme that diverges stops early, with a warning), 1 an I/O error\n"
-      "  (a full disk; no file is left), 2 bad input, 128+N killed by signal N (no file left).");
+      "  With loss, energy + dissipated energy is what stays constant (50).\n" +
+      std::string(kRunFooter));
   return fpu;
 }
 

@@ -42,18 +42,14 @@ CLI::App* addPlateCommand(CLI::App& app, PlateArguments& a) {
   number("--ly", a.ly, "M", "side along y (> 0)");
   number("--sigma0", a.sigma0, "1/S", "frequency-independent loss σ0 (>= 0)");
   number("--sigma1", a.sigma1, "M2/S", "frequency-dependent loss σ1 (>= 0)");
-  cmd->add_option("--out", a.out, "CSV file to write (replaced whole, or left untouched on error)")
-      ->type_name("PATH")
-      ->required();
+  addOutputOption(cmd, a.out);
   cmd->footer(
       "CSV: a comment line '# nx=.. ny=.. h=.. hy=.. k=..' (interior points; h along x), a\n"
       "  header, then one row per written step n: t,q,energy,psi. t = n k; q = q^n at the grid\n"
       "  point nearest the probe; energy = H^{n+1/2} of (41) (sv: (41) with ψ = 0 plus\n"
       "  V'(q^n)); psi = ψ^{n+1/2} (0 for sv). With loss, energy + dissipated is what stays\n"
-      "  constant.\n"
-      "Steps: floor(duration / k); the last row is at t = steps · k.\n"
-      "Exit codes: 0 done (a scheme that diverges stops early, with a warning), 1 an I/O error\n"
-      "  (a full disk; no file is left), 2 bad input, 128+N killed by signal N (no file left).");
+      "  constant.\n" +
+      std::string(kRunFooter));
   return cmd;
 }
 

@@ -56,19 +56,15 @@ CLI::App* addStringCommand(CLI::App& app, StringArguments& a) {
   number("--tension", a.tension, "N", "tension T0 (> 0)");
   number("--sigma0", a.sigma0, "1/S", "frequency-independent loss σ0 (>= 0)");
   number("--sigma1", a.sigma1, "M2/S", "frequency-dependent loss σ1 (>= 0)");
-  cmd->add_option("--out", a.out, "CSV file to write (replaced whole, or left untouched on error)")
-      ->type_name("PATH")
-      ->required();
+  addOutputOption(cmd, a.out);
   cmd->footer(
       "CSV: a comment line '# segments=M h=... k=...', a header, then one row per written step\n"
       "  n: t,u,v,energy,psi. t = n k; u, v = u^n, v^n at the grid point nearest probe·L;\n"
       "  energy = H^{n+1/2} of (41) (sv: (41) with ψ = 0 plus V'(u^n, v^n)), with the gauge\n"
       "  shift ε excluded; psi = ψ^{n+1/2} of the string's potential (0 for sv;\n"
       "  a hammer strike has a second ψ, the felt's, which is not written). With loss,\n"
-      "  energy + dissipated is what stays constant.\n"
-      "Steps: floor(duration / k); the last row is at t = steps · k.\n"
-      "Exit codes: 0 done (a scheme that diverges stops early, with a warning), 1 an I/O error\n"
-      "  (a full disk; no file is left), 2 bad input, 128+N killed by signal N (no file left).");
+      "  energy + dissipated is what stays constant.\n" +
+      std::string(kRunFooter));
   return cmd;
 }
 
