@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "models/grid.h"
 #include "util/format_number.h"
 
 namespace hamiltone {
@@ -187,17 +188,7 @@ int plateSegments(const PlatePhysics& p, double length, double k, double factor,
   const double a = 16.0 * k * k * kappa * kappa, b = 8.0 * sigma1 * k;
   const double xMax = (-b + std::sqrt(b * b + 4.0 * a)) / (2.0 * a);  // the largest 1/h²
   const double h = factor / std::sqrt(xMax);
-  const double segments = std::floor(length / h);
-  if (!(segments >= 2.0))
-    throw std::invalid_argument("plate side " + formatNumber(length) +
-                                " m is shorter than two grid "
-                                "spacings h = " +
-                                formatNumber(h) + " m at k = " + formatNumber(k) +
-                                " s (bound (84)); use a smaller time step");
-  if (segments > 2000.0)
-    throw std::invalid_argument("the plate grid would have " + formatNumber(segments) +
-                                " segments per side; expected at most 2000");
-  return static_cast<int>(segments);
+  return segmentsAlong(length, h, k, 2000.0, "plate side", "bound (84)");
 }
 
 }  // namespace hamiltone

@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "models/grid.h"
 #include "util/format_number.h"
 
 namespace hamiltone {
@@ -183,18 +184,9 @@ int gridSegments(const StringPhysics& p, GridRule rule, double k, double sigma1,
   if (!(factor >= 1.0) || !std::isfinite(factor))
     throw std::invalid_argument("grid factor = " + formatNumber(factor) + ": must be >= 1");
   const double h = factor * minimalSpacing(p, rule, k, sigma1);
-  const double segments = std::floor(p.length / h);
-  if (!(segments >= 2.0))
-    throw std::invalid_argument(
-        "length = " + formatNumber(p.length) +
-        " m: shorter than two grid "
-        "spacings h = " +
-        formatNumber(h) + " m at k = " + formatNumber(k) +
-        " s; use a smaller time step (oversampling) or a smaller grid factor");
-  if (segments > 1e6)
-    throw std::invalid_argument("the grid would have " + formatNumber(segments) +
-                                " segments; expected at most 1e6 (use a larger time step)");
-  return static_cast<int>(segments);
+  return segmentsAlong(
+      p.length, h, k, 1e6, "length",
+      rule == GridRule::transverse ? "stiff-string bound (44)" : "h >= sqrt(E/rho) k");
 }
 
 }  // namespace hamiltone

@@ -1,0 +1,29 @@
+// How many grid segments fit a length at a spacing — shared by the string and the plate grids.
+#pragma once
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "util/format_number.h"
+
+namespace hamiltone {
+
+// floor(length / h), refused below 2 or above `maximum` with a message naming `what` (the
+// length's parameter) and `rule` (where h came from).
+inline int segmentsAlong(double length, double h, double k, double maximum, const std::string& what,
+                         const std::string& rule) {
+  const double segments = std::floor(length / h);
+  if (!(segments >= 2.0))
+    throw std::invalid_argument(
+        what + " = " + formatNumber(length) + " m: shorter than two grid spacings h = " +
+        formatNumber(h) + " m at k = " + formatNumber(k) + " s (" + rule +
+        "); use a smaller time step (oversampling) or a smaller grid factor");
+  if (segments > maximum)
+    throw std::invalid_argument("the grid would have " + formatNumber(segments) +
+                                " segments along " + what + "; expected at most " +
+                                formatNumber(maximum) + " (use a larger time step)");
+  return static_cast<int>(segments);
+}
+
+}  // namespace hamiltone
