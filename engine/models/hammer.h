@@ -48,6 +48,7 @@ class HammeredString {
   Eigen::Index size() const { return inverseMass_.size(); }
   Eigen::Index hammerIndex() const { return size() - 1; }
   const NonlinearString& string() const { return string_; }
+  NonlinearString& string() { return string_; }  // for the bend (setTensionScale)
   const Hammer& hammer() const { return hammer_; }
 
   const Vector& inverseMass() const { return inverseMass_; }

@@ -59,13 +59,13 @@ NonlinearString::NonlinearString(const StringPhysics& p, int segments)
 void NonlinearString::applyStiffness(const Vector& q, Vector& out) const {
   const Eigen::Index n = segments_ - 1;
   const double invH2 = 1.0 / (h_ * h_);
-  const double t = physics_.tension * h_;
-  secondDifference(q.data() + n, out.data() + n, n, -t * invH2);  // −T0 h D2 v
+  secondDifference(q.data() + n, out.data() + n, n, -physics_.tension * h_ * invH2);  // −T0 h D2 v
+  const double t = tensionScale_ * physics_.tension * h_;
   if (physics_.inertia == 0.0) {
-    secondDifference(q.data(), out.data(), n, -t * invH2);  // −T0 h D2 u
+    secondDifference(q.data(), out.data(), n, -t * invH2);  // −βT0 h D2 u
     return;
   }
-  // h (−T0 D2 + EI D2²) u. D2² with D2 u = 0 at the ends is the simply supported biharmonic.
+  // h (−βT0 D2 + EI D2²) u. D2² with D2 u = 0 at the ends is the simply supported biharmonic.
   const double ei = physics_.young * physics_.inertia * h_;
   double* d2u = work1_.data();
   double* d4u = work2_.data();
@@ -75,10 +75,14 @@ void NonlinearString::applyStiffness(const Vector& q, Vector& out) const {
 }
 
 double NonlinearString::transverseEigenvalue(int m) const {
+  return transverseEigenvalue(m, tensionScale_);
+}
+
+double NonlinearString::transverseEigenvalue(int m, double scale) const {
   const double s = std::sin(m * std::numbers::pi / (2.0 * segments_));
   const double rhoA = physics_.linearDensity();
   const double h2 = h_ * h_;
-  return physics_.tension / rhoA * 4.0 / h2 * s * s +
+  return scale * physics_.tension / rhoA * 4.0 / h2 * s * s +
          physics_.young * physics_.inertia / rhoA * 16.0 / (h2 * h2) * s * s * s * s;
 }
 
@@ -87,8 +91,17 @@ double NonlinearString::longitudinalEigenvalue(int m) const {
   return physics_.tension / physics_.linearDensity() * 4.0 / (h_ * h_) * s * s;
 }
 
+void NonlinearString::setTensionRange(double maxScale) {
+  if (!(maxScale >= 1.0 && maxScale <= 4.0))
+    throw std::invalid_argument("tension scale range " + formatNumber(maxScale) +
+                                ": must be between 1 and 4 (two octaves of bend)");
+  tensionScaleMax_ = maxScale;
+  tensionScale_ = 1.0;
+}
+
 double NonlinearString::stiffnessEigenvalueMax() const {
-  return transverseEigenvalue(segments_ - 1);  // >= the longitudinal one, mode by mode
+  // At the largest β the range allows; >= the longitudinal eigenvalue, mode by mode.
+  return transverseEigenvalue(segments_ - 1, tensionScaleMax_);
 }
 
 double NonlinearString::lossOperatorEigenvalueMax() const {

@@ -2,6 +2,8 @@
 // grid with fixed ends, split as (65) with bending stiffness EI ∂x⁴u added to K.
 #pragma once
 
+#include <algorithm>
+
 #include "schemes/hamiltonian.h"
 
 namespace hamiltone {
@@ -44,8 +46,16 @@ class NonlinearString {
   void applyLossOperator(const Vector& a, const Vector& b, Vector& out) const;
   double lossOperatorEigenvalueMax() const;  // λmax(−D2) < 4/h²
 
-  // Eigenvalue m = 1 … M−1 of M⁻¹K on u: (T0/ρA)(4/h²) s² + (EI/ρA)(16/h⁴) s⁴, s = sin(mπ/2M).
+  // Pitch bend: the transverse wave sees the tension β·T0 (the longitudinal wave and V' keep T0,
+  // as a tuning peg's small stretch leaves EA − T0 unchanged). stiffnessEigenvalueMax() answers for
+  // the largest β allowed, so a scheme built after setTensionRange() stays stable for any bend.
+  void setTensionRange(double maxScale);  // >= 1; resets β to 1
+  void setTensionScale(double scale) { tensionScale_ = std::clamp(scale, 0.0, tensionScaleMax_); }
+  double tensionScale() const { return tensionScale_; }
+
+  // Eigenvalue m = 1 … M−1 of M⁻¹K on u: (βT0/ρA)(4/h²) s² + (EI/ρA)(16/h⁴) s⁴, s = sin(mπ/2M).
   double transverseEigenvalue(int m) const;
+  double transverseEigenvalue(int m, double scale) const;  // at β = scale
   // Of M⁻¹K on v: (T0/ρA)(4/h²) s².
   double longitudinalEigenvalue(int m) const;
 
@@ -54,6 +64,7 @@ class NonlinearString {
   int segments_;
   double h_;
   Vector inverseMass_;
+  double tensionScale_ = 1.0, tensionScaleMax_ = 1.0;
   mutable Vector work1_, work2_;  // per-segment work of the stencils and the gradient, size M
 };
 

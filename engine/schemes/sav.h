@@ -120,6 +120,9 @@ class SavScheme {
   // Zero when the parameters turned trackDissipation off.
   double dissipated() const { return dissipated_; }
   const S& system() const { return system_; }
+  // For a parameter change between steps that the system bounds itself, such as a string's bend
+  // within the tension range it was built with: (44) was checked once, at construction.
+  S& system() { return system_; }
   const StepParameters& parameters() const { return params_; }
 
  private:

@@ -232,8 +232,8 @@ void PlateVoice::process(std::span<float> left, std::span<float> right) noexcept
     reset();
     return;
   }
-  if (quiet_.update(released_, e.kinetic, scheme_->supplied(),
-                    static_cast<double>(left.size()) / sampleRate_))
+  if (quiet_.update(released_, blockPeak(left, right, rightCount),
+                    static_cast<double>(left.size()) / sampleRate_, left, right, rightCount))
     active_ = false;
 }
 

@@ -36,6 +36,13 @@ double wavenumberSquared(const StringPhysics& p, double omega) {
   return (-c2 + std::sqrt(c2 * c2 + 4.0 * kappa2 * omega * omega)) / (2.0 * kappa2);
 }
 
+// The tension scale β that puts the scheme's fundamental on `hz` (the inverse of schemePartial).
+double bendScale(const NonlinearString& s, double k, double hz) {
+  const double root = 2.0 / k * std::sin(std::numbers::pi * k * hz);
+  const double offset = s.transverseEigenvalue(1, 0.0);
+  return (root * root - offset) / (s.transverseEigenvalue(1, 1.0) - offset);
+}
+
 }  // namespace
 
 StringLoss stringLossFromT60(const StringPhysics& string, double t60Low, double t60High,
@@ -75,24 +82,36 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
           "a number > 1");
   require(std::isfinite(patch.epsilon) && patch.epsilon >= 0.0, "epsilon_j", patch.epsilon,
           "a finite number >= 0 J");
+  require(patch.bendRange >= 0.0 && patch.bendRange <= 12.0, "bend_range_semitones",
+          patch.bendRange, "between 0 and 12 semitones");
 
   // Everything is built in locals and committed only once nothing more can throw, so a failed
   // prepare() leaves the voice as it was.
   const double k = 1.0 / (sampleRate * r);
   const double target = equalTemperament(midiNote, patch.a4Hz);
   // The loss sets the grid (its σ1 tightens (44)) and the tuning sets the loss (ξ depends on T0):
-  // two rounds settle both, σ1 being a small correction.
+  // two rounds settle both, σ1 being a small correction. The grid leaves room for the bend's
+  // largest tension β: h_min grows at most as sqrt(β) (minimalSpacing), so a coarser factor covers
+  // it; β itself depends on the grid through the stiffness term, hence a third round if needed.
+  const double widest = std::pow(2.0, 2.0 * patch.bendRange / 12.0);
+  double betaMax = widest;
   TunedString tuned{patch.string, 0};
   StringLoss loss;
-  for (int round = 0; round < 2; ++round) {
+  for (int round = 0; round < 3; ++round) {
     loss = stringLossFromT60(tuned.physics, patch.t60Low, patch.t60High, patch.t60HighHz);
-    tuned = tuneString(patch.string, patch.tuneBy, patch.grid, k, loss.sigma1, patch.gridFactor,
-                       target);
+    tuned = tuneString(patch.string, patch.tuneBy, patch.grid, k, loss.sigma1,
+                       patch.gridFactor * std::sqrt(betaMax), target);
+    const NonlinearString s(tuned.physics, tuned.segments);
+    const double need = bendScale(s, k, target * std::pow(2.0, patch.bendRange / 12.0));
+    if (round > 0 && need <= betaMax) break;
+    betaMax = std::max(widest, need);
   }
   require((loss.sigma0 + kLn1000 / patch.damperT60) * k < 1.0, "damper_t60_s", patch.damperT60,
           "longer than ln(1000) k / (1 − σ0 k) = " +
               formatNumber(kLn1000 * k / (1.0 - loss.sigma0 * k)) + " s at this rate");
-  const HammeredString system(NonlinearString(tuned.physics, tuned.segments), patch.hammer);
+  NonlinearString string(tuned.physics, tuned.segments);
+  string.setTensionRange(betaMax);
+  const HammeredString system(std::move(string), patch.hammer);
   InitialState rest{Vector::Zero(system.size()), Vector::Zero(system.size())};
   rest.q[system.hammerIndex()] = kParkedAt;
   const StepParameters params{.k = k,
@@ -110,6 +129,9 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
   k_ = k;
   loss_ = loss;
   fundamental_ = schemePartial(system.string(), k, 1);
+  bendOffset_ = system.string().transverseEigenvalue(1, 0.0);
+  bendSlope_ = system.string().transverseEigenvalue(1, 1.0) - bendOffset_;
+  bend_ = 0.0;
   scheme_ = std::move(scheme);
   atRest_ = std::move(atRest);
   for (int c = 0; c < 2; ++c) decimators_[c] = std::move(decimators[c]);
@@ -123,6 +145,21 @@ void StringVoice::reset() noexcept {
   separatedSteps_ = 0;
   quiet_.reset();
   active_ = released_ = struck_ = false;
+  applyBend();  // the copy brought back β = 1
+}
+
+void StringVoice::setBend(double semitones) noexcept {
+  // A NaN passes through std::clamp, so it is caught first.
+  bend_ = std::isnan(semitones) ? 0.0 : std::clamp(semitones, -patch_.bendRange, patch_.bendRange);
+  applyBend();
+}
+
+// f1 = (1/πk) arcsin(k sqrt(λ1)/2) (schemePartial) with λ1 = β·bendSlope_ + bendOffset_: the β
+// that puts f1 at fundamental·2^(bend/12).
+void StringVoice::applyBend() noexcept {
+  const double f = fundamental_ * std::pow(2.0, bend_ / 12.0);
+  const double root = 2.0 / k_ * std::sin(std::numbers::pi * k_ * f);
+  scheme_->system().string().setTensionScale((root * root - bendOffset_) / bendSlope_);
 }
 
 int StringVoice::segments() const { return scheme_->system().string().segments(); }
@@ -235,8 +272,8 @@ void StringVoice::process(std::span<float> left, std::span<float> right) noexcep
     reset();
     return;
   }
-  if (quiet_.update(released_, e.kinetic, injected_,
-                    static_cast<double>(left.size()) / sampleRate_))
+  if (quiet_.update(released_, blockPeak(left, right, rightCount),
+                    static_cast<double>(left.size()) / sampleRate_, left, right, rightCount))
     active_ = false;
 }
 

@@ -35,6 +35,7 @@ struct StringPatch {
   double velocityMin = 0.5, velocityMax = 6.0,
          velocityCurve = 1.0;        // m/s = min + (max−min)·v^curve
   double guardEnergyMultiple = 4.0;  // silence when H exceeds this multiple of the injected energy
+  double bendRange = 2.0;  // semitones each way that setBend() reaches; 0 keeps the finest grid
 };
 
 // σ(ξ) = σ0 + σ1 ξ is the decay rate of a mode of wavenumber² ξ; two T60s fix it (data §3.4):
@@ -54,6 +55,9 @@ class StringVoice {
 
   void noteOn(double velocity) noexcept;  // velocity 0 … 1
   void release() noexcept;                // the damper falls
+  // Bends the pitch by `semitones` (clamped to ±bendRange) by retensioning the transverse wave:
+  // β T0 is solved in closed form so the scheme's fundamental moves by exactly that interval.
+  void setBend(double semitones) noexcept;
 
   // Writes (not adds) the next left.size() samples; a stereo patch also writes the first
   // min(left, right) samples of right, a mono one leaves right alone. Never allocates.
@@ -74,6 +78,7 @@ class StringVoice {
  private:
   double pickup(const Vector& q, const Vector& qNext, double position) const;
   void catchHammer() noexcept;
+  void applyBend() noexcept;
 
   StringPatch patch_;
   std::unique_ptr<SplitSav<HammeredString>> scheme_;
@@ -82,6 +87,7 @@ class StringVoice {
   QuietDetector quiet_;
   StringLoss loss_;
   double sampleRate_ = 0.0, k_ = 0.0, fundamental_ = 0.0;
+  double bend_ = 0.0, bendSlope_ = 0.0, bendOffset_ = 0.0;  // λ1(β) = bendSlope_·β + bendOffset_
   double injected_ = 0.0, caught_ = 0.0;
   int guardEvents_ = 0;
   int separatedSteps_ = 0;
