@@ -6,8 +6,11 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev       # engine: vectors and the scheme state
-  libcli11-dev        # render/: hamiltone-sim's command line
+  libcli11-dev        # render/: hamiltone-sim's and hamiltone-render's command lines
+  libtomlplusplus-dev # engine/presets: the TOML preset files
+  libsndfile1-dev     # render/: hamiltone-render's WAV output
   libgtest-dev libgmock-dev  # tests/
+  clang libclang-rt-14-dev   # tests/fuzz: libFuzzer targets for the MIDI reader and preset loader
   libbenchmark-dev    # bench/
 )
 

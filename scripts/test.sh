@@ -7,4 +7,13 @@ cd "$(dirname "$0")/.."
 ./scripts/install-deps.sh
 cmake -S . -B build/ci -G Ninja -DCMAKE_BUILD_TYPE=Release -DHAMILTONE_WERROR=ON >/dev/null
 cmake --build build/ci
+
+# The libFuzzer targets (tests/fuzz) need Clang and sanitizer flags, so they have a tree of their
+# own; each fuzzes for HAMILTONE_FUZZ_SECONDS (30 s). Only their targets are built there. This runs
+# before the main suite so that the suite's summary stays the last thing printed.
+CC=clang CXX=clang++ cmake -S . -B build/fuzz -G Ninja -DHAMILTONE_FUZZ=ON \
+  -DHAMILTONE_BUILD_TESTS=OFF -DHAMILTONE_BUILD_BENCH=OFF -DHAMILTONE_BUILD_RENDER=OFF >/dev/null
+cmake --build build/fuzz --target hamiltone_fuzzers
+ctest --test-dir build/fuzz --output-on-failure
+
 ctest --test-dir build/ci --output-on-failure -j "$(nproc)"
