@@ -1,0 +1,78 @@
+// The line is redrawn in place with '\r' and padded with spaces over a longer previous line, so
+// it needs no terminal escape codes.
+#include "progress_bar.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace hamiltone::cli {
+
+namespace {
+
+constexpr auto kRedrawInterval = std::chrono::milliseconds(100);
+
+// "0:07", "12:34" or "1:02:03"; "--" beyond 100 h.
+std::string formattedEta(double seconds) {
+  if (!(seconds >= 0.0 && seconds < 100.0 * 3600.0)) return "--";
+  const long s = std::lround(seconds);
+  char text[48];
+  if (s >= 3600)
+    std::snprintf(text, sizeof text, "%ld:%02ld:%02ld", s / 3600, s / 60 % 60, s % 60);
+  else
+    std::snprintf(text, sizeof text, "%ld:%02ld", s / 60, s % 60);
+  return text;
+}
+
+}  // namespace
+
+bool progressWanted(bool quiet) { return !quiet && ::isatty(STDERR_FILENO) == 1; }
+
+ProgressBar::ProgressBar(double totalSeconds, bool enabled, std::FILE* out)
+    : total_(totalSeconds), enabled_(enabled), out_(out), start_(Clock::now()) {}
+
+void ProgressBar::update(double doneSeconds) {
+  if (!enabled_) return;
+  const Clock::time_point now = Clock::now();
+  if (drawnWidth_ > 0 && now - lastDraw_ < kRedrawInterval) return;
+  lastDraw_ = now;
+
+  const double fraction = total_ > 0.0 ? std::clamp(doneSeconds / total_, 0.0, 1.0) : 1.0;
+  const double elapsed = std::chrono::duration<double>(now - start_).count();
+  // Nothing done yet: no estimate.
+  const std::string eta =
+      doneSeconds > 0.0
+          ? formattedEta(std::max(elapsed * (total_ - doneSeconds) / doneSeconds, 0.0))
+          : "--";
+  char line[96];
+  const int width =
+      std::snprintf(line, sizeof line, "%4d%%  %.1f s of %.1f s  ETA %s",
+                    static_cast<int>(100.0 * fraction), doneSeconds, total_, eta.c_str());
+  std::fprintf(out_, "\r%s%*s", line, std::max(drawnWidth_ - width, 0), "");
+  std::fflush(out_);
+  drawnWidth_ = width;
+}
+
+void ProgressBar::finish() {
+  if (drawnWidth_ == 0) return;
+  std::fprintf(out_, "\r%*s\r", drawnWidth_, "");
+  std::fflush(out_);
+  drawnWidth_ = 0;
+}
+
+std::string renderSummary(double renderedSeconds, double wallSeconds) {
+  char text[160];
+  const int n = std::snprintf(text, sizeof text, "rendered %.2f s of audio in %.2f s",
+                              renderedSeconds, wallSeconds);
+  if (renderedSeconds > 0.0 && wallSeconds > 0.0) {
+    const double factor = wallSeconds / renderedSeconds;
+    const bool faster = factor <= 1.0;
+    std::snprintf(text + n, sizeof text - static_cast<std::size_t>(n),
+                  " (real-time factor %.3f, %.1fx %s than real time)", factor,
+                  faster ? 1.0 / factor : factor, faster ? "faster" : "slower");
+  }
+  return text;
+}
+
+}  // namespace hamiltone::cli

@@ -1,0 +1,41 @@
+// The render's progress line on stderr, and the one-line summary printed when it is done.
+#pragma once
+
+#include <chrono>
+#include <cstdio>
+#include <string>
+
+namespace hamiltone::cli {
+
+// True when stderr is a terminal and --quiet was not given: the case for a ProgressBar.
+bool progressWanted(bool quiet);
+
+class ProgressBar {
+ public:
+  // Draws nothing unless `enabled` (see progressWanted); `out` is stderr but for tests.
+  ProgressBar(double totalSeconds, bool enabled, std::FILE* out = stderr);
+  ~ProgressBar() { finish(); }  // an exception that ends the render leaves no half line
+  ProgressBar(const ProgressBar&) = delete;
+  ProgressBar& operator=(const ProgressBar&) = delete;
+
+  // Redraws the line — "  42%  5.3 s of 12.5 s  ETA 0:07" — at most ten times a second, the
+  // first call at once. The ETA assumes the rest renders as fast as what is done so far.
+  void update(double doneSeconds);
+  // Clears the line, so what is printed next starts at the left edge; idempotent.
+  void finish();
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  double total_;
+  bool enabled_;
+  std::FILE* out_;
+  Clock::time_point start_, lastDraw_;
+  int drawnWidth_ = 0;  // characters on the line now, 0 if nothing is drawn
+};
+
+// "rendered 12.50 s of audio in 3.10 s (real-time factor 0.248, 4.0x faster than real time)".
+// The real-time factor is wall time / audio time: below 1 renders faster than it plays.
+// A wall time of 0 (below the clock's resolution) or no audio leaves the factor out.
+std::string renderSummary(double renderedSeconds, double wallSeconds);
+
+}  // namespace hamiltone::cli

@@ -1,0 +1,49 @@
+// A WAV file written through libsndfile that appears whole on commit() or not at all.
+#pragma once
+
+#include <sndfile.h>
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "atomic_file.h"
+
+namespace hamiltone::cli {
+
+enum class SampleFormat { pcm16, pcm24, float32 };
+
+class WavWriter {
+ public:
+  // Creates the temporary beside `path` now (see AtomicFile), so a bad path fails before any
+  // rendering: UsageError naming `flag` for an empty path, a directory, a device or an
+  // unwritable directory; std::invalid_argument for a sample rate <= 0 or channels not 1 or 2;
+  // std::runtime_error naming the path if libsndfile refuses the format.
+  WavWriter(std::string path, const std::string& flag, int sampleRate, int channels,
+            SampleFormat format);
+  ~WavWriter();  // closes and removes the temporary unless committed
+  WavWriter(const WavWriter&) = delete;
+  WavWriter& operator=(const WavWriter&) = delete;
+
+  // Appends `frames` interleaved frames. Each sample is sanitised first — NaN and ±Inf become 0,
+  // the rest is clamped to [-1, 1] — so one bad sample cannot wrap around in PCM or put a NaN
+  // or a value past full scale in a float file. Copies through a buffer sized once in the
+  // constructor, so a call allocates nothing.
+  // Throws std::runtime_error naming the path and libsndfile's message (a full disk).
+  void write(const float* interleaved, std::size_t frames);
+  // Writes the header, closes and renames onto the path; throws std::runtime_error on an error.
+  void commit();
+
+  const std::string& path() const { return path_; }
+  int sampleRate() const { return sampleRate_; }
+  int channels() const { return channels_; }
+
+ private:
+  std::string path_;
+  int sampleRate_, channels_;
+  AtomicFile file_;
+  SNDFILE* sound_ = nullptr;  // writes through the temporary's descriptor
+  std::vector<float> chunk_;  // sanitised samples on their way to libsndfile
+};
+
+}  // namespace hamiltone::cli

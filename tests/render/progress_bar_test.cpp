@@ -1,0 +1,98 @@
+// ProgressBar and renderSummary: the summary's wording and arithmetic, a disabled bar that stays
+// silent, and an enabled one that draws one '\r' line, throttled, and clears it.
+#include "progress_bar.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <string>
+
+namespace {
+
+using hamiltone::cli::ProgressBar;
+using hamiltone::cli::renderSummary;
+
+// A temporary stream standing in for stderr; text() is everything written so far.
+class CapturedStream {
+ public:
+  CapturedStream() : file_(std::tmpfile()) {}
+  ~CapturedStream() { std::fclose(file_); }
+  std::FILE* get() { return file_; }
+  std::string text() {
+    std::fflush(file_);
+    std::string all;
+    std::rewind(file_);
+    for (int c; (c = std::fgetc(file_)) != EOF;) all.push_back(static_cast<char>(c));
+    return all;
+  }
+
+ private:
+  std::FILE* file_;
+};
+
+TEST(RenderSummary, RealTimeFactorIsWallOverAudioTime) {
+  EXPECT_EQ(renderSummary(12.5, 3.1),
+            "rendered 12.50 s of audio in 3.10 s (real-time factor 0.248, 4.0x faster than real "
+            "time)");
+  EXPECT_EQ(renderSummary(2.0, 5.0),
+            "rendered 2.00 s of audio in 5.00 s (real-time factor 2.500, 2.5x slower than real "
+            "time)");
+}
+
+TEST(RenderSummary, NoFactorWithoutAWallTimeOrAudio) {
+  EXPECT_EQ(renderSummary(12.5, 0.0), "rendered 12.50 s of audio in 0.00 s");
+  EXPECT_EQ(renderSummary(0.0, 1.0), "rendered 0.00 s of audio in 1.00 s");
+}
+
+TEST(ProgressBar, DisabledWritesNothing) {
+  CapturedStream out;
+  {
+    ProgressBar bar(10.0, false, out.get());
+    bar.update(0.0);
+    bar.update(5.0);
+    bar.finish();
+  }
+  EXPECT_EQ(out.text(), "");
+}
+
+TEST(ProgressBar, EnabledDrawsOneLineInPlaceAndClearsIt) {
+  CapturedStream out;
+  ProgressBar bar(10.0, true, out.get());
+  bar.update(5.0);
+  const std::string line = out.text();
+  EXPECT_EQ(line.rfind("\r  50%  5.0 s of 10.0 s  ETA ", 0), 0u) << line;
+  EXPECT_EQ(line.find('\n'), std::string::npos);
+
+  bar.finish();
+  // Back to the left edge, the drawn characters (all but the '\r') overwritten with spaces, and
+  // back again.
+  std::string blank(line.size() + 1, ' ');
+  blank.front() = blank.back() = '\r';
+  const std::string cleared = out.text().substr(line.size());
+  EXPECT_EQ(cleared, blank);
+  bar.finish();
+  EXPECT_EQ(out.text().size(), line.size() + cleared.size());  // nothing left to clear
+}
+
+TEST(ProgressBar, RedrawsAtMostTenTimesASecond) {
+  CapturedStream out;
+  const auto start = std::chrono::steady_clock::now();
+  ProgressBar bar(10.0, true, out.get());
+  for (int i = 1; i <= 100; ++i) bar.update(0.1 * i);
+  if (std::chrono::steady_clock::now() - start >= std::chrono::milliseconds(100))
+    GTEST_SKIP() << "the machine took 100 ms over 100 updates; a second redraw was allowed";
+  const std::string text = out.text();
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\r'), 1) << text;
+}
+
+TEST(ProgressBar, DestructorClearsTheLine) {
+  CapturedStream out;
+  { ProgressBar(10.0, true, out.get()).update(1.0); }
+  const std::string text = out.text();
+  ASSERT_FALSE(text.empty());
+  EXPECT_EQ(text.back(), '\r');
+}
+
+}  // namespace

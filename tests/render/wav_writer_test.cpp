@@ -1,0 +1,247 @@
+// WavWriter: what libsndfile reads back is what was written, to the format's quantisation step;
+// bad samples come back sanitised; and no file, whole or partial, is left unless committed.
+#include "wav_writer.h"
+
+#include <gtest/gtest.h>
+#include <sndfile.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <numbers>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "usage_error.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using hamiltone::cli::SampleFormat;
+using hamiltone::cli::UsageError;
+using hamiltone::cli::WavWriter;
+
+struct Sound {
+  SF_INFO info{};
+  std::vector<float> samples;  // interleaved
+};
+
+Sound readBack(const fs::path& path) {
+  Sound sound;
+  SNDFILE* file = sf_open(path.c_str(), SFM_READ, &sound.info);
+  if (!file) throw std::runtime_error(std::string("cannot read back: ") + sf_strerror(nullptr));
+  sound.samples.resize(static_cast<std::size_t>(sound.info.frames * sound.info.channels));
+  const sf_count_t read = sf_readf_float(file, sound.samples.data(), sound.info.frames);
+  sf_close(file);
+  if (read != sound.info.frames) throw std::runtime_error("short read");
+  return sound;
+}
+
+// The files in `dir`: after a failure there must be none, not even a temporary.
+std::vector<std::string> listing(const fs::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dir)) names.push_back(entry.path().filename());
+  return names;
+}
+
+class WavWriterTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string name = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    for (char& c : name)
+      if (c == '/') c = '_';  // parametrised tests are named "Case/3"
+    dir_ = fs::temp_directory_path() / ("hamiltone-wav-" + std::to_string(::getpid()) + "-" + name);
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    fs::permissions(dir_, fs::perms::owner_all, fs::perm_options::add);
+    fs::remove_all(dir_);
+  }
+
+  fs::path wav() const { return dir_ / "out.wav"; }
+
+  fs::path dir_;
+};
+
+// Round trips at both common rates, in every format, mono and stereo.
+class WavRoundTrip : public WavWriterTest,
+                     public ::testing::WithParamInterface<std::tuple<int, SampleFormat, int>> {};
+
+TEST_P(WavRoundTrip, ReadsBackWhatWasWrittenToTheQuantisationStep) {
+  const auto [rate, format, channels] = GetParam();
+  // 10007 frames in two calls, the second longer than the writer's 4096-frame chunk, so the
+  // chunking and the joins are exercised. The channels differ (sine, half-amplitude cosine) so a
+  // swapped interleave shows.
+  const std::size_t frames = 10007;
+  std::vector<float> signal(frames * static_cast<std::size_t>(channels));
+  for (std::size_t i = 0; i < frames; ++i) {
+    const double phase = 2.0 * std::numbers::pi * 440.0 * static_cast<double>(i) / rate;
+    signal[i * channels] = static_cast<float>(0.8 * std::sin(phase));
+    if (channels == 2) signal[i * 2 + 1] = static_cast<float>(0.5 * std::cos(phase));
+  }
+  {
+    WavWriter writer(wav().string(), "-o", rate, channels, format);
+    writer.write(signal.data(), 3000);
+    writer.write(signal.data() + 3000 * channels, frames - 3000);
+    writer.commit();
+  }
+
+  const Sound sound = readBack(wav());
+  EXPECT_EQ(sound.info.samplerate, rate);
+  EXPECT_EQ(sound.info.channels, channels);
+  EXPECT_EQ(sound.info.frames, static_cast<sf_count_t>(frames));
+  const int subformat = format == SampleFormat::pcm16   ? SF_FORMAT_PCM_16
+                        : format == SampleFormat::pcm24 ? SF_FORMAT_PCM_24
+                                                        : SF_FORMAT_FLOAT;
+  EXPECT_EQ(sound.info.format, SF_FORMAT_WAV | subformat);
+
+  // A quantiser is off by less than one step: libsndfile 1.2.0 with clipping on scales by 2^15
+  // or 2^23 and rounds down (measured), and reading divides by the same power of two exactly.
+  // A 32-bit float is stored as it is.
+  const double step = format == SampleFormat::pcm16   ? std::ldexp(1.0, -15)
+                      : format == SampleFormat::pcm24 ? std::ldexp(1.0, -23)
+                                                      : 0.0;
+  ASSERT_EQ(sound.samples.size(), signal.size());
+  double worst = 0.0;
+  for (std::size_t i = 0; i < signal.size(); ++i)
+    worst = std::max(worst, std::abs(double(sound.samples[i]) - double(signal[i])));
+  if (format == SampleFormat::float32)
+    EXPECT_EQ(worst, 0.0);
+  else
+    EXPECT_LT(worst, step);
+}
+
+INSTANTIATE_TEST_SUITE_P(RatesFormatsChannels, WavRoundTrip,
+                         ::testing::Combine(::testing::Values(44100, 48000),
+                                            ::testing::Values(SampleFormat::pcm16,
+                                                              SampleFormat::pcm24,
+                                                              SampleFormat::float32),
+                                            ::testing::Values(1, 2)));
+
+// NaN and ±Inf become silence, the rest is clamped to full scale.
+const std::vector<float> kBadSamples = {std::numeric_limits<float>::quiet_NaN(),
+                                        std::numeric_limits<float>::infinity(),
+                                        -std::numeric_limits<float>::infinity(),
+                                        1.5f,
+                                        -2.0f,
+                                        1.0f,
+                                        -1.0f,
+                                        0.25f};
+const std::vector<float> kSanitised = {0.0f, 0.0f, 0.0f, 1.0f, -1.0f, 1.0f, -1.0f, 0.25f};
+
+TEST_F(WavWriterTest, FloatFileHoldsSanitisedSamplesExactly) {
+  WavWriter writer(wav().string(), "-o", 48000, 1, SampleFormat::float32);
+  writer.write(kBadSamples.data(), kBadSamples.size());
+  writer.commit();
+  EXPECT_EQ(readBack(wav()).samples, kSanitised);
+}
+
+TEST_F(WavWriterTest, PcmFileSaturatesInsteadOfWrapping) {
+  WavWriter writer(wav().string(), "-o", 48000, 2, SampleFormat::pcm16);
+  writer.write(kBadSamples.data(), kBadSamples.size() / 2);
+  writer.commit();
+  const Sound sound = readBack(wav());
+  ASSERT_EQ(sound.samples.size(), kSanitised.size());
+  // +1 saturates at the largest code, 1 - 2^-15: one step short, the largest error allowed.
+  for (std::size_t i = 0; i < kSanitised.size(); ++i)
+    EXPECT_NEAR(sound.samples[i], kSanitised[i], std::ldexp(1.0, -15)) << "sample " << i;
+}
+
+TEST_F(WavWriterTest, ExceptionBeforeCommitLeavesNoFileAndNoTemporary) {
+  try {
+    WavWriter writer(wav().string(), "-o", 44100, 2, SampleFormat::pcm24);
+    writer.write(kSanitised.data(), kSanitised.size() / 2);
+    throw std::runtime_error("the render failed");
+  } catch (const std::runtime_error&) {
+  }
+  EXPECT_TRUE(listing(dir_).empty());
+}
+
+TEST_F(WavWriterTest, UncommittedWriterLeavesAnExistingFileUntouched) {
+  std::ofstream(wav()) << "the previous take";
+  { WavWriter writer(wav().string(), "-o", 44100, 1, SampleFormat::pcm16); }
+  std::stringstream kept;
+  kept << std::ifstream(wav()).rdbuf();
+  EXPECT_EQ(kept.str(), "the previous take");
+  EXPECT_EQ(listing(dir_).size(), 1u);
+}
+
+TEST_F(WavWriterTest, CommitReplacesAnExistingFile) {
+  std::ofstream(wav()) << "the previous take";
+  WavWriter writer(wav().string(), "-o", 44100, 1, SampleFormat::pcm16);
+  writer.write(kSanitised.data(), kSanitised.size());
+  writer.commit();
+  EXPECT_EQ(readBack(wav()).info.frames, static_cast<sf_count_t>(kSanitised.size()));
+  EXPECT_EQ(listing(dir_).size(), 1u);
+}
+
+TEST_F(WavWriterTest, SignalRemovesTheTemporary) {
+  // The child dies by SIGTERM mid-write; atomic_file's handler unlinks the temporary and exits
+  // with 128 + 15, as a shell reports a killed process.
+  EXPECT_EXIT(
+      {
+        WavWriter writer(wav().string(), "-o", 44100, 1, SampleFormat::pcm16);
+        writer.write(kSanitised.data(), kSanitised.size());
+        std::raise(SIGTERM);
+      },
+      ::testing::ExitedWithCode(128 + SIGTERM), "");
+  EXPECT_TRUE(listing(dir_).empty());
+}
+
+TEST_F(WavWriterTest, MissingDirectoryIsAUsageErrorNamingFlagAndPath) {
+  const std::string path = (dir_ / "no-such-dir" / "out.wav").string();
+  try {
+    WavWriter writer(path, "-o", 44100, 1, SampleFormat::pcm16);
+    FAIL() << "expected UsageError";
+  } catch (const UsageError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("-o = " + path), std::string::npos) << message;
+    EXPECT_NE(message.find("cannot write there"), std::string::npos) << message;
+  }
+}
+
+TEST_F(WavWriterTest, ReadOnlyDirectoryIsAUsageErrorNamingThePath) {
+  if (::geteuid() == 0) GTEST_SKIP() << "root writes into a read-only directory";
+  fs::permissions(dir_, fs::perms::owner_write | fs::perms::group_write | fs::perms::others_write,
+                  fs::perm_options::remove);
+  EXPECT_THROW(
+      {
+        try {
+          WavWriter writer(wav().string(), "-o", 44100, 1, SampleFormat::pcm16);
+        } catch (const UsageError& e) {
+          EXPECT_NE(std::string(e.what()).find(wav().string()), std::string::npos) << e.what();
+          throw;
+        }
+      },
+      UsageError);
+}
+
+TEST_F(WavWriterTest, DirectoryAndDeviceAreRefused) {
+  EXPECT_THROW(WavWriter(dir_.string(), "-o", 44100, 1, SampleFormat::pcm16), UsageError);
+  EXPECT_THROW(WavWriter("/dev/null", "-o", 44100, 1, SampleFormat::pcm16), UsageError);
+  EXPECT_THROW(WavWriter("", "-o", 44100, 1, SampleFormat::pcm16), UsageError);
+}
+
+TEST_F(WavWriterTest, BadLayoutIsRefusedBeforeATemporaryIsMade) {
+  EXPECT_THROW(WavWriter(wav().string(), "-o", 44100, 3, SampleFormat::pcm16),
+               std::invalid_argument);
+  EXPECT_THROW(WavWriter(wav().string(), "-o", 0, 1, SampleFormat::pcm16), std::invalid_argument);
+  EXPECT_TRUE(listing(dir_).empty());
+}
+
+TEST_F(WavWriterTest, WriteAfterCommitIsALogicError) {
+  WavWriter writer(wav().string(), "-o", 44100, 1, SampleFormat::float32);
+  writer.commit();
+  EXPECT_THROW(writer.write(kSanitised.data(), 1), std::logic_error);
+  EXPECT_EQ(readBack(wav()).info.frames, 0);
+}
+
+}  // namespace
