@@ -72,6 +72,7 @@ class StringVoice {
   double removedEnergy() const { return caught_; }
   int guardEvents() const { return guardEvents_; }
   double fundamentalHz() const { return fundamental_; }
+  int channels() const { return patch_.channels; }
   int segments() const;
   const SplitSav<HammeredString>& scheme() const { return *scheme_; }
 

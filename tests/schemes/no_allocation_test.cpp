@@ -14,6 +14,8 @@
 #include "models/plate.h"
 #include "presets/piano_scale.h"
 #include "support/fpu_runs.h"
+#include "support/test_instruments.h"
+#include "synth/synth.h"
 #include "voices/plate_voice.h"
 #include "voices/string_voice.h"
 
@@ -176,6 +178,29 @@ TEST(NoAllocation, PlateVoiceProcess) {
   forbidAllocation(false);
   EXPECT_EQ(forbiddenNews - before, 0);
   EXPECT_EQ(voice.guardEvents(), 0);
+}
+
+// The synthesizer's process(): every kind of event, a steal and its pending re-strike, the plate,
+// a program change, blocks of several sizes (1 to the prepared maximum, and beyond it).
+TEST(NoAllocation, SynthProcess) {
+  Synth synth;
+  synth.prepare({testing::pianoKeys(48, 52, 2), testing::smallPlate()},
+                {.sampleRate = 48000.0, .maxBlock = 256, .notes = {}});
+  std::vector<float> left(600), right(600);
+  const SynthEvent events[] = {
+      {0, {0x90, 48, 100}}, {3, {0x90, 50, 60}},  {5, {0xB0, 64, 127}},  {9, {0x90, 52, 127}},
+      {11, {0x80, 48, 0}},  {20, {0xE0, 0, 100}}, {30, {0x90, 48, 90}},  {40, {0xB0, 7, 90}},
+      {41, {0xB0, 64, 0}},  {50, {0xC0, 1, 0}},   {51, {0x90, 60, 127}}, {60, {0xB0, 123, 0}},
+      {70, {0xB0, 120, 0}}, {71, {0x90, 61, 80}}, {80, {0xF0, 0, 0}},    {90, {0xB0, 121, 0}}};
+  const long before = forbiddenNews;
+  forbidAllocation(true);
+  synth.process(left, right, events);
+  for (int frames : {1, 64, 256, 600})
+    for (int block = 0; block < 4; ++block)
+      synth.process(std::span(left).first(frames), std::span(right).first(frames), {});
+  forbidAllocation(false);
+  EXPECT_EQ(forbiddenNews - before, 0);
+  EXPECT_EQ(synth.guardEvents(), 0);
 }
 
 TEST(NoAllocation, MarazzatoWithEveryQuadrature) {

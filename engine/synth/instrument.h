@@ -1,0 +1,35 @@
+// An instrument: what one preset file describes, ready for the synthesizer to build voices from —
+// a string per key (with its unisons) or a plate sized to each note.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "voices/plate_voice.h"
+#include "voices/string_voice.h"
+
+namespace hamiltone {
+
+enum class InstrumentModel { string, plate };
+
+// One key of a string instrument: 1 to 3 unison strings from one patch, spread in pitch.
+struct StringKey {
+  StringPatch patch;         // tuned to the key's note by the voice
+  int unisons = 1;           // 1, 2 or 3
+  double detuneCents = 0.0;  // between the outermost strings: they sit at ±detune/2 (and 0)
+};
+
+struct Instrument {
+  std::string name;    // shown to the player
+  std::string source;  // the preset file it came from
+  InstrumentModel model = InstrumentModel::string;
+  int lowestNote = 21, highestNote = 108;  // MIDI; notes outside are ignored
+  std::vector<StringKey> keys;             // string model: keys[note − lowestNote]
+  PlatePatch plate;                        // plate model: PlateVoice sizes it to each note
+  int polyphony = 16;                      // keys sounding at once, at most
+  double gainDb = 0.0;                     // applied to the sum of the voices
+  double bendRange = 2.0;                  // semitones each way of the pitch wheel (strings)
+  double panSpread = 0.5;                  // 0: all centred; 1: lowest key left … highest right
+};
+
+}  // namespace hamiltone

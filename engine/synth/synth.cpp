@@ -1,0 +1,232 @@
+// The synthesizer's event handling (MIDI semantics, voice allocation and stealing) and its block
+// loop: events applied at their exact sample, voices summed, then the master section.
+#include "synth/synth.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "synth/denormals.h"
+
+namespace hamiltone {
+
+void Synth::prepare(std::vector<Instrument> instruments, const SynthSetup& setup) {
+  if (instruments.empty()) throw std::invalid_argument("no instrument to play");
+  if (setup.maxBlock < 1 || setup.maxBlock > 65536)
+    throw std::invalid_argument("block size " + std::to_string(setup.maxBlock) +
+                                ": must be between 1 and 65536 frames");
+  std::vector<std::vector<KeyVoice>> voices(instruments.size());
+  std::vector<std::vector<bool>> hasVoice(instruments.size());
+  std::vector<double> gains;
+  for (size_t p = 0; p < instruments.size(); ++p) {
+    const Instrument& instrument = instruments[p];
+    const int count = instrument.highestNote - instrument.lowestNote + 1;
+    voices[p].resize(count);
+    hasVoice[p].assign(count, false);
+    for (int i = 0; i < count; ++i) {
+      const int note = instrument.lowestNote + i;
+      if (!setup.notes.empty() &&
+          (note >= static_cast<int>(setup.notes.size()) || !setup.notes[note]))
+        continue;
+      try {
+        voices[p][i].prepare(instrument, note, setup.sampleRate, setup.maxBlock);
+      } catch (const std::exception& e) {
+        throw std::invalid_argument(instrument.source + ": note " + std::to_string(note) + ": " +
+                                    e.what());
+      }
+      hasVoice[p][i] = true;
+    }
+    gains.push_back(std::pow(10.0, instrument.gainDb / 20.0));
+  }
+  MasterBus master;
+  master.prepare(setup.sampleRate);
+
+  instruments_ = std::move(instruments);
+  voices_ = std::move(voices);
+  hasVoice_ = std::move(hasVoice);
+  gains_ = std::move(gains);
+  master_ = master;
+  maxBlock_ = setup.maxBlock;
+  program_ = 0;
+  std::fill(std::begin(downProgram_), std::end(downProgram_), -1);
+  sustain_ = false;
+  bend_ = 0.0;
+  strikes_ = 0;
+}
+
+KeyVoice* Synth::keyVoice(int program, int note) {
+  const Instrument& instrument = instruments_[program];
+  if (note < instrument.lowestNote || note > instrument.highestNote) return nullptr;
+  const int i = note - instrument.lowestNote;
+  return hasVoice_[program][i] ? &voices_[program][i] : nullptr;
+}
+
+const KeyVoice* Synth::voice(int program, int note) const {
+  if (program < 0 || program >= static_cast<int>(instruments_.size())) return nullptr;
+  return const_cast<Synth*>(this)->keyVoice(program, note);
+}
+
+int Synth::polyphony() const {
+  return polyphonyOverride_ > 0 ? polyphonyOverride_ : instruments_[program_].polyphony;
+}
+
+int Synth::activeVoices() const {
+  int count = 0;
+  for (const auto& keys : voices_)
+    for (const KeyVoice& v : keys) count += v.sounding() && !v.fading();
+  return count;
+}
+
+int Synth::guardEvents() const {
+  int events = 0;
+  for (const auto& keys : voices_)
+    for (const KeyVoice& v : keys) events += v.guardEvents();
+  return events;
+}
+
+// Released keys first (neither held nor sustained), then any; the quietest of them by the peak of
+// their latest block, the oldest on a tie. It fades out over 5 ms.
+void Synth::stealOne() noexcept {
+  KeyVoice* victim = nullptr;
+  auto better = [&](const KeyVoice& v) {
+    if (!victim) return true;
+    const bool free = !v.down && !v.sustained, victimFree = !victim->down && !victim->sustained;
+    if (free != victimFree) return free;
+    if (v.lastPeak() != victim->lastPeak()) return v.lastPeak() < victim->lastPeak();
+    return v.order() < victim->order();
+  };
+  for (auto& keys : voices_)
+    for (KeyVoice& v : keys)
+      if (v.sounding() && !v.fading() && better(v)) victim = &v;
+  if (victim) victim->fadeOut();
+}
+
+void Synth::noteOn(int note, int velocity) noexcept {
+  KeyVoice* voice = keyVoice(program_, note);
+  if (!voice) return;
+  const double v = velocity / 127.0;
+  if (voice->fading()) {
+    voice->strikeAfterFade(v, ++strikes_);
+  } else {
+    if (!voice->sounding())
+      while (activeVoices() >= polyphony()) stealOne();
+    voice->setBend(bend_ * instruments_[program_].bendRange);
+    voice->strike(v, ++strikes_);
+    voice->down = true;
+  }
+  voice->sustained = false;
+  downProgram_[note] = program_;
+}
+
+void Synth::noteOff(int note) noexcept {
+  if (downProgram_[note] < 0) return;
+  KeyVoice* voice = keyVoice(downProgram_[note], note);
+  downProgram_[note] = -1;
+  if (!voice || !voice->down) return;
+  voice->down = false;
+  if (sustain_)
+    voice->sustained = true;
+  else
+    voice->release();
+}
+
+void Synth::setSustain(bool down) noexcept {
+  if (down == sustain_) return;
+  sustain_ = down;
+  if (down) return;
+  for (auto& keys : voices_)
+    for (KeyVoice& v : keys)
+      if (v.sustained) {
+        v.sustained = false;
+        v.release();
+      }
+}
+
+void Synth::setBend(double fraction) noexcept {
+  bend_ = fraction;
+  for (size_t p = 0; p < voices_.size(); ++p)
+    for (KeyVoice& v : voices_[p])
+      if (v.sounding()) v.setBend(bend_ * instruments_[p].bendRange);
+}
+
+void Synth::allSoundOff() noexcept {
+  for (auto& keys : voices_)
+    for (KeyVoice& v : keys) v.fadeOut();
+  std::fill(std::begin(downProgram_), std::end(downProgram_), -1);
+}
+
+void Synth::handle(const MidiMessage& m) noexcept {
+  switch (m.kind()) {
+    case midi::noteOn:
+      if (m.data2 > 0) {
+        noteOn(m.data1 & 0x7F, m.data2 & 0x7F);
+        break;
+      }
+      [[fallthrough]];
+    case midi::noteOff:
+      noteOff(m.data1 & 0x7F);
+      break;
+    case midi::controller:
+      switch (m.data1) {
+        case midi::sustainPedal:
+          setSustain(m.data2 >= 64);
+          break;
+        case midi::volume: {
+          const double v = (m.data2 & 0x7F) / 127.0;
+          master_.setVolume(v * v);
+          break;
+        }
+        case midi::allSoundOff:
+          allSoundOff();
+          break;
+        case midi::resetControllers:
+          setBend(0.0);
+          setSustain(false);
+          break;
+        case midi::allNotesOff:
+          for (int note = 0; note < 128; ++note) noteOff(note);
+          break;
+        default:
+          break;
+      }
+      break;
+    case midi::pitchBend:
+      setBend((((m.data2 & 0x7F) << 7 | (m.data1 & 0x7F)) - 8192) / 8192.0);
+      break;
+    case midi::program:
+      if (m.data1 < instruments_.size()) program_ = m.data1;
+      break;
+    default:
+      break;
+  }
+}
+
+void Synth::render(std::span<float> left, std::span<float> right) noexcept {
+  for (size_t p = 0; p < voices_.size(); ++p)
+    for (KeyVoice& v : voices_[p])
+      if (v.sounding()) v.process(left, right, gains_[p]);
+}
+
+void Synth::process(std::span<float> left, std::span<float> right,
+                    std::span<const SynthEvent> events) noexcept {
+  const ScopedFlushToZero ftz;
+  const size_t frames = std::min(left.size(), right.size());
+  std::fill(left.begin(), left.begin() + frames, 0.0f);
+  std::fill(right.begin(), right.begin() + frames, 0.0f);
+  size_t done = 0, next = 0;
+  while (done < frames) {
+    // Events due at or before this sample, then the samples up to the next event (or a whole
+    // maxBlock piece): the voices' scratch buffers hold maxBlock samples.
+    while (next < events.size() && static_cast<size_t>(std::max(events[next].offset, 0)) <= done)
+      handle(events[next++].message);
+    size_t until = std::min(frames, done + static_cast<size_t>(maxBlock_));
+    if (next < events.size()) until = std::min(until, static_cast<size_t>(events[next].offset));
+    render(left.subspan(done, until - done), right.subspan(done, until - done));
+    done = until;
+  }
+  while (next < events.size()) handle(events[next++].message);  // offsets past the block's end
+  master_.process(left.first(frames), right.first(frames));
+}
+
+}  // namespace hamiltone

@@ -1,0 +1,84 @@
+// The synthesizer: the loaded instruments, a voice for every key of each (built in prepare(),
+// never on the audio path), MIDI semantics, voice allocation under a polyphony limit, and the
+// master section. process() is real-time safe: no allocation, lock or I/O.
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "midi/midi_message.h"
+#include "synth/instrument.h"
+#include "synth/key_voice.h"
+#include "synth/master_bus.h"
+
+namespace hamiltone {
+
+// A message at a sample offset inside the block being processed.
+struct SynthEvent {
+  int offset = 0;
+  MidiMessage message;
+};
+
+struct SynthSetup {
+  double sampleRate = 48000.0;
+  int maxBlock = 1024;  // process() takes any number of frames; it works in pieces of this size
+  // Which MIDI notes get voices; empty: every note of each instrument's range. An offline render
+  // that knows its notes saves the preparation of the others (plates are slow to prepare).
+  std::vector<bool> notes;
+};
+
+// MIDI, omni (every channel plays the current instrument):
+//   note on/off (velocity 0 is a note-off); a note-on for a sounding key re-strikes that key's
+//   voice (its strings keep vibrating, as on a piano); CC64 sustain: 64…127 down, 0…63 up — no
+//   half-pedalling: a half value is simply up or down by that threshold; CC7 volume, gain
+//   (value/127)², smoothed over 10 ms; CC120 all sound off: every voice fades out in 5 ms;
+//   CC121 reset controllers: bend centred, pedal up; CC123 all notes off: as a note-off for every
+//   held key (the pedal still sustains them); pitch bend ±bend_range_semitones of the instrument
+//   (strings retension, plates do not bend); program change n selects instrument n (ignored
+//   beyond the last), sounding notes ring on in the old one.
+class Synth {
+ public:
+  // May allocate; throws std::invalid_argument naming the instrument, note and patch field.
+  void prepare(std::vector<Instrument> instruments, const SynthSetup& setup);
+
+  // Writes left.size() frames (right must be as long). `events` sorted by offset, each offset in
+  // [0, left.size()); an event out of order or range is applied at the nearest valid sample.
+  void process(std::span<float> left, std::span<float> right,
+               std::span<const SynthEvent> events) noexcept;
+  void handle(const MidiMessage& message) noexcept;  // now, between two samples
+
+  // The limit on sounding keys; 0 restores the instrument's own polyphony.
+  void setPolyphony(int voices) noexcept { polyphonyOverride_ = voices; }
+  int polyphony() const;
+  int activeVoices() const;
+  int program() const { return program_; }
+  int guardEvents() const;
+  long nonFiniteSamples() const { return master_.nonFinite(); }
+  const std::vector<Instrument>& instruments() const { return instruments_; }
+  // The key's voice, or nullptr when that note has none.
+  const KeyVoice* voice(int program, int note) const;
+
+ private:
+  void render(std::span<float> left, std::span<float> right) noexcept;
+  void noteOn(int note, int velocity) noexcept;
+  void noteOff(int note) noexcept;
+  void setSustain(bool down) noexcept;
+  void setBend(double fraction) noexcept;
+  void allSoundOff() noexcept;
+  KeyVoice* keyVoice(int program, int note);
+  void stealOne() noexcept;
+
+  std::vector<Instrument> instruments_;
+  std::vector<std::vector<KeyVoice>> voices_;  // [instrument][note − lowest]
+  std::vector<std::vector<bool>> hasVoice_;
+  std::vector<double> gains_;  // per instrument, linear
+  MasterBus master_;
+  int maxBlock_ = 0;
+  int program_ = 0, polyphonyOverride_ = 0;
+  int downProgram_[128];  // which instrument's voice a held note struck (−1: none)
+  bool sustain_ = false;
+  double bend_ = 0.0;  // −1 … 1 of the range
+  long strikes_ = 0;
+};
+
+}  // namespace hamiltone

@@ -1,0 +1,244 @@
+// The synthesizer: MIDI semantics (sustain, re-strike, all notes off, bend, program, volume),
+// voice allocation under the polyphony limit and its stealing order, a click-free steal, the
+// master section's bounds, determinism and independence of the block size.
+#include "synth/synth.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "support/modal.h"
+#include "support/test_instruments.h"
+#include "synth/denormals.h"
+
+namespace hamiltone {
+namespace {
+
+using testing::pianoKeys;
+
+constexpr double kRate = 48000.0;
+
+MidiMessage on(int note, int velocity = 100) { return {0x90, uint8_t(note), uint8_t(velocity)}; }
+MidiMessage off(int note) { return {0x80, uint8_t(note), 0}; }
+MidiMessage cc(int controller, int value) { return {0xB0, uint8_t(controller), uint8_t(value)}; }
+
+struct Take {
+  std::vector<float> left, right;
+};
+
+// Renders `seconds` with the messages at their times (seconds), in blocks of `block` frames.
+Take render(Synth& synth, std::vector<TimedMessage> messages, double seconds, int block) {
+  const long frames = std::lround(seconds * kRate);
+  Take take{std::vector<float>(frames), std::vector<float>(frames)};
+  std::vector<SynthEvent> events;
+  size_t next = 0;
+  for (long start = 0; start < frames; start += block) {
+    const long n = std::min<long>(block, frames - start);
+    events.clear();
+    while (next < messages.size() && std::lround(messages[next].seconds * kRate) < start + n) {
+      events.push_back(
+          {int(std::lround(messages[next].seconds * kRate) - start), messages[next].message});
+      ++next;
+    }
+    synth.process(std::span(take.left).subspan(start, n), std::span(take.right).subspan(start, n),
+                  events);
+  }
+  return take;
+}
+
+Synth prepared(std::vector<Instrument> instruments, int maxBlock = 256) {
+  Synth synth;
+  synth.prepare(std::move(instruments), {.sampleRate = kRate, .maxBlock = maxBlock, .notes = {}});
+  return synth;
+}
+
+float peak(const std::vector<float>& x, size_t from = 0, size_t to = SIZE_MAX) {
+  float p = 0.0f;
+  for (size_t i = from; i < std::min(to, x.size()); ++i) p = std::max(p, std::abs(x[i]));
+  return p;
+}
+
+TEST(Synth, SustainHoldsReleasedNotesUntilThePedalLifts) {
+  Synth synth = prepared({pianoKeys(48, 50)});
+  render(synth, {{0.0, cc(64, 127)}, {0.0, on(48)}, {0.1, off(48)}}, 0.5, 256);
+  EXPECT_TRUE(synth.voice(0, 48)->sounding());  // the pedal holds it
+  EXPECT_TRUE(synth.voice(0, 48)->sustained);
+  // A value under 64 is the pedal up: the damper falls and the voice frees itself.
+  render(synth, {{0.0, cc(64, 63)}}, 1.5, 256);
+  EXPECT_FALSE(synth.voice(0, 48)->sounding());
+  // Without the pedal a note-off releases at once (the damper, T60 0.25 s: gone within 1 s).
+  render(synth, {{0.0, on(49)}, {0.1, {0x90, 49, 0}}}, 1.2, 256);  // velocity 0 is a note-off
+  EXPECT_FALSE(synth.voice(0, 49)->sounding());
+}
+
+TEST(Synth, RestrikingASoundingKeyReexcitesTheSameVoice) {
+  Synth synth = prepared({pianoKeys(48, 48)});
+  render(synth, {{0.0, on(48, 60)}}, 0.2, 64);
+  const long first = synth.voice(0, 48)->order();
+  const Take take = render(synth, {{0.0, on(48, 120)}}, 0.2, 64);
+  EXPECT_EQ(synth.activeVoices(), 1);
+  EXPECT_GT(synth.voice(0, 48)->order(), first);
+  EXPECT_GT(peak(take.left), 0.0f);
+}
+
+TEST(Synth, AllNotesOffReleasesHeldKeysAndAllSoundOffSilences) {
+  Synth synth = prepared({pianoKeys(48, 52)});
+  render(synth, {{0.0, on(48)}, {0.0, on(50)}, {0.0, on(52)}}, 0.2, 256);
+  EXPECT_EQ(synth.activeVoices(), 3);
+  render(synth, {{0.0, cc(123, 0)}}, 1.2, 256);
+  EXPECT_EQ(synth.activeVoices(), 0);
+
+  const Take before = render(synth, {{0.0, on(48)}, {0.0, on(50)}}, 0.2, 256);
+  const Take take = render(synth, {{0.0, cc(120, 0)}}, 0.3, 256);
+  EXPECT_EQ(synth.activeVoices(), 0);
+  // After the 5 ms fade only the master's 5 Hz DC blocker still rings, decaying with its 32 ms
+  // time constant: 1e-3 of the level before, a quarter second on.
+  EXPECT_LT(peak(take.left, 12000), 1e-3f * peak(before.left));
+}
+
+TEST(Synth, PolyphonyLimitStealsReleasedKeysFirstThenTheQuietest) {
+  Synth synth = prepared({pianoKeys(48, 60, 3)});
+  // 48 soft and held, 50 loud and held, 52 loud and released: at the limit of 3, a fourth key
+  // steals 52 (released) although 48 is quieter.
+  render(synth, {{0.0, on(48, 20)}, {0.0, on(50, 127)}, {0.0, on(52, 127)}, {0.05, off(52)}}, 0.1,
+         64);
+  ASSERT_EQ(synth.activeVoices(), 3);
+  render(synth, {{0.0, on(55)}}, 0.02, 64);
+  EXPECT_FALSE(synth.voice(0, 52)->sounding());
+  EXPECT_TRUE(synth.voice(0, 48)->sounding());
+  EXPECT_EQ(synth.activeVoices(), 3);
+  // All held now: the quietest (48, struck softly) goes.
+  render(synth, {{0.0, on(57)}}, 0.02, 64);
+  EXPECT_FALSE(synth.voice(0, 48)->sounding());
+  EXPECT_TRUE(synth.voice(0, 50)->sounding());
+  // The CLI's --voices overrides the preset's polyphony.
+  synth.setPolyphony(1);
+  render(synth, {{0.0, on(59)}}, 0.02, 64);
+  EXPECT_EQ(synth.activeVoices(), 1);
+}
+
+// The stolen voice fades linearly over 5 ms: no sample-to-sample step larger than the note's own
+// largest step plus its peak / 240 (the fade's slope per sample at 48 kHz).
+TEST(Synth, StealingDoesNotClick) {
+  Synth synth = prepared({pianoKeys(48, 60, 1)});
+  Take take = render(synth, {{0.0, on(60, 127)}, {0.3, on(48, 1)}}, 0.35, 64);
+  const size_t steal = std::lround(0.3 * kRate);
+  float before = 0.0f, during = 0.0f;
+  for (size_t i = steal - 4800; i < steal; ++i)
+    before = std::max(before, std::abs(take.left[i] - take.left[i - 1]));
+  for (size_t i = steal; i < steal + 480; ++i)
+    during = std::max(during, std::abs(take.left[i] - take.left[i - 1]));
+  const float level = peak(take.left, steal - 4800, steal);
+  ASSERT_GT(level, 1e-3f);
+  EXPECT_LE(during, before + level / 240.0f + 1e-6f);
+  EXPECT_EQ(synth.activeVoices(), 1);
+}
+
+TEST(Synth, OutputIsBitIdenticalForTheSameInput) {
+  const std::vector<TimedMessage> score = {
+      {0.0, on(48)}, {0.05, on(52, 30)}, {0.1, cc(64, 127)}, {0.15, off(48)}, {0.2, {0xE0, 0, 80}}};
+  Synth a = prepared({pianoKeys(48, 55)}), b = prepared({pianoKeys(48, 55)});
+  const Take x = render(a, score, 0.4, 64), y = render(b, score, 0.4, 64);
+  EXPECT_EQ(x.left, y.left);
+  EXPECT_EQ(x.right, y.right);
+}
+
+// Blocks of 1, 64 and 1000 frames: events land on the same samples and every voice runs sample by
+// sample, so the takes agree to float roundoff.
+TEST(Synth, OutputDoesNotDependOnTheBlockSize) {
+  const std::vector<TimedMessage> score = {
+      {0.0, on(48)}, {0.0123, on(52, 30)}, {0.05, off(48)}, {0.07, {0xE0, 0, 90}}, {0.09, on(48)}};
+  std::vector<Take> takes;
+  for (int block : {1, 64, 1000}) {
+    Synth synth = prepared({pianoKeys(48, 55)}, 1000);
+    takes.push_back(render(synth, score, 0.15, block));
+  }
+  const float level = peak(takes[0].left);
+  ASSERT_GT(level, 1e-3f);
+  for (size_t t = 1; t < takes.size(); ++t)
+    for (size_t i = 0; i < takes[0].left.size(); ++i) {
+      ASSERT_NEAR(takes[t].left[i], takes[0].left[i], 1e-6f * level)
+          << "block take " << t << " at " << i;
+      ASSERT_NEAR(takes[t].right[i], takes[0].right[i], 1e-6f * level);
+    }
+}
+
+// A note-on at offset 37 of a block starts exactly there: the output before it is silent.
+TEST(Synth, EventsApplyAtTheirSampleOffset) {
+  Synth synth = prepared({pianoKeys(60, 60)});
+  std::vector<float> l(256), r(256);
+  const SynthEvent events[] = {{37, on(60, 127)}};
+  synth.process(l, r, events);
+  EXPECT_EQ(peak(l, 0, 37), 0.0f);
+  EXPECT_GT(peak(l, 37, 256), 0.0f);
+}
+
+// The wheel retunes the string: at full bend up the fundamental is 2 semitones higher, within a
+// cent (measured from the output's zero crossings).
+TEST(Synth, PitchBendMovesTheFundamentalByTheRange) {
+  for (int wheel : {16383, 0}) {
+    Synth synth = prepared({pianoKeys(57, 57)});
+    const double expected = 220.0 * std::pow(2.0, (wheel ? 2.0 : -2.0) / 12.0);
+    MidiMessage bend{0xE0, uint8_t(wheel & 0x7F), uint8_t(wheel >> 7)};
+    const Take take = render(synth, {{0.0, bend}, {0.0, on(57, 40)}}, 1.0, 256);
+    std::vector<double> x(take.left.begin() + 24000, take.left.end());
+    const double measured = testing::zeroCrossingFrequency(x, 1.0 / kRate);
+    EXPECT_NEAR(testing::cents(measured, expected), 0.0, 1.0) << "wheel " << wheel;
+  }
+}
+
+TEST(Synth, ProgramChangeSelectsAnInstrumentAndIgnoresOthers) {
+  Synth synth = prepared({pianoKeys(48, 50), pianoKeys(60, 62)});
+  render(synth, {{0.0, {0xC0, 1, 0}}, {0.0, on(60)}, {0.01, {0xC0, 9, 0}}}, 0.05, 64);
+  EXPECT_EQ(synth.program(), 1);
+  EXPECT_TRUE(synth.voice(1, 60)->sounding());
+  EXPECT_EQ(synth.voice(0, 60), nullptr);
+}
+
+// The limiter: four loud keys with +24 dB of gain stay inside the ceiling; CC7 = 0 silences.
+TEST(Synth, MasterNeverLeavesTheUnitRange) {
+  Instrument loud = pianoKeys(48, 60);
+  loud.gainDb = 24.0;
+  Synth synth = prepared({loud});
+  const Take take = render(
+      synth, {{0.0, on(48, 127)}, {0.0, on(52, 127)}, {0.0, on(55, 127)}, {0.0, on(60, 127)}}, 0.3,
+      256);
+  EXPECT_GT(peak(take.left), 0.9f);
+  EXPECT_LE(peak(take.left), MasterBus::kCeiling + 1e-6);
+  EXPECT_LE(peak(take.right), MasterBus::kCeiling + 1e-6);
+  const Take muted = render(synth, {{0.0, cc(7, 0)}}, 0.3, 256);
+  EXPECT_LT(peak(muted.left, 9600), 1e-3f);  // 10 ms smoothing: −87 dB after 0.2 s
+}
+
+TEST(Synth, FlushToZeroIsOnWhileProcessingAndRestoredAfter) {
+  const bool outside = ScopedFlushToZero::active();
+  {
+    const ScopedFlushToZero ftz;
+    EXPECT_TRUE(ScopedFlushToZero::active());
+    volatile double tiny = 1e-310;  // subnormal
+    EXPECT_EQ(tiny * 0.5, 0.0);
+  }
+  EXPECT_EQ(ScopedFlushToZero::active(), outside);
+}
+
+TEST(Synth, RejectsBadSetups) {
+  Synth synth;
+  EXPECT_THROW(synth.prepare({}, {}), std::invalid_argument);
+  EXPECT_THROW(
+      synth.prepare({pianoKeys(60, 60)}, {.sampleRate = kRate, .maxBlock = 0, .notes = {}}),
+      std::invalid_argument);
+  Instrument broken = pianoKeys(60, 60);
+  broken.keys[0].patch.oversampling = 3;
+  try {
+    synth.prepare({broken}, {});
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(),
+                 "pianoKeys(60, 60): note 60: oversampling = 3: must be 1, 2, 4, 8 or 16");
+  }
+}
+
+}  // namespace
+}  // namespace hamiltone
