@@ -1,0 +1,975 @@
+// Reading a preset: the TOML syntax (toml++), every key against the parameter table (name, type,
+// range, model, per key), the bounds one parameter sets another, the per-key values between the
+// [[key]] anchors, the Instrument itself, and the voices' own checks at a few keys.
+#include "presets/preset_loader.h"
+
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <numbers>
+#include <optional>
+#include <set>
+
+#include "presets/parameters.h"
+#include "voices/plate_voice.h"
+#include "voices/string_voice.h"
+
+namespace hamiltone {
+
+namespace {
+
+constexpr size_t kMaxBytes = size_t{1} << 20;
+constexpr size_t kMaxAnchors = 128;
+constexpr size_t kMaxLines = 100;     // lines in a PresetError, the last one counting the rest
+constexpr size_t kMaxKept = 1000;     // errors kept for sorting; beyond, only counted
+constexpr size_t kMaxSuggested = 64;  // longer names get no "did you mean"
+constexpr size_t kMaxShown = 40;      // bytes of a name or text value quoted in a message
+constexpr size_t kMaxText = 200;      // bytes of a text parameter
+constexpr double kCheckRate = 48000.0;
+
+struct Place {
+  long line = 1, column = 1;
+  auto operator<=>(const Place&) const = default;
+};
+
+Place placeOf(const toml::source_region& region) {
+  if (region.begin.line == 0) return {};
+  return {static_cast<long>(region.begin.line), static_cast<long>(region.begin.column)};
+}
+
+// A value the file sets: a number (real, integer, note; a boolean as 1 or 0) or a word, where it
+// stands, and how a message shows it.
+struct Setting {
+  double number = 0.0;
+  std::string word = {};
+  Place place;
+  std::string shown;
+};
+
+using Settings = std::map<std::string_view, Setting>;  // by the table's name of the parameter
+
+struct Anchor {
+  int note = 0;
+  Place place;        // of its note = …
+  std::string shown;  // the note as written
+  Settings values;
+};
+
+// Where a value came from, and how an error line names it: "key[C3].string.tension_N = 759".
+struct Blame {
+  Place place;
+  std::string text;
+};
+
+// At most kMaxShown bytes of `s`, cut at a character boundary; control characters become '?'.
+std::string clip(std::string_view s, bool quoted) {
+  size_t n = std::min(s.size(), kMaxShown);
+  while (n > 0 && n < s.size() && (static_cast<unsigned char>(s[n]) & 0xC0) == 0x80) --n;
+  std::string out = quoted ? "\"" : "";
+  for (char c : s.substr(0, n)) {
+    if (quoted && (c == '"' || c == '\\')) out += '\\';
+    out += static_cast<unsigned char>(c) < 0x20 || c == 0x7F ? '?' : c;
+  }
+  if (n < s.size()) out += "…";
+  return quoted ? out + "\"" : out;
+}
+
+std::string show(const toml::node& v) {
+  if (const auto* s = v.as_string()) return clip(s->get(), true);
+  if (const auto* i = v.as_integer()) return std::to_string(i->get());
+  if (const auto* f = v.as_floating_point()) return compactNumber(f->get());
+  if (const auto* b = v.as_boolean()) return b->get() ? "true" : "false";
+  if (v.is_table()) return "{…}";
+  if (v.is_array()) return "[…]";
+  return "(a date or time)";
+}
+
+// A value computed for a key rather than written: six significant digits.
+std::string approximate(double x) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.6g", x);
+  return buffer;
+}
+
+std::string_view modelName(InstrumentModel m) {
+  return m == InstrumentModel::string ? "string" : "plate";
+}
+
+bool inChoices(std::string_view choices, std::string_view word) {
+  while (true) {
+    const size_t bar = choices.find('|');
+    if (choices.substr(0, bar) == word) return true;
+    if (bar == std::string_view::npos) return false;
+    choices.remove_prefix(bar + 1);
+  }
+}
+
+// "\"string\" or \"plate\"", "one of 1, 2, 4, 8, 16".
+std::string listChoices(std::string_view choices, bool quoted) {
+  std::vector<std::string> words;
+  for (size_t start = 0; start <= choices.size();) {
+    const size_t bar = std::min(choices.find('|', start), choices.size());
+    const std::string word(choices.substr(start, bar - start));
+    words.push_back(quoted ? "\"" + word + "\"" : word);
+    start = bar + 1;
+  }
+  if (words.size() == 2) return words[0] + " or " + words[1];
+  std::string out = "one of ";
+  for (size_t i = 0; i < words.size(); ++i) out += (i > 0 ? ", " : "") + words[i];
+  return out;
+}
+
+std::string rangeText(const Parameter& p) {
+  return compactNumber(p.min) + " … " + compactNumber(p.max);
+}
+
+char lower(char c) { return c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c; }
+
+// Edits (insert, delete, substitute, swap two neighbours) from a to b, case aside.
+size_t distance(std::string_view a, std::string_view b) {
+  std::vector<size_t> before(b.size() + 1), previous(b.size() + 1), row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) previous[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t change = lower(a[i - 1]) == lower(b[j - 1]) ? 0 : 1;
+      row[j] = std::min({previous[j] + 1, row[j - 1] + 1, previous[j - 1] + change});
+      if (i > 1 && j > 1 && lower(a[i - 1]) == lower(b[j - 2]) &&
+          lower(a[i - 2]) == lower(b[j - 1]))
+        row[j] = std::min(row[j], before[j - 2] + 1);
+    }
+    std::swap(before, previous);
+    std::swap(previous, row);
+  }
+  return previous[b.size()];
+}
+
+std::string_view leaf(std::string_view name) { return name.substr(name.rfind('.') + 1); }
+
+// "; did you mean X?" for the candidate a slip away from `name` (a few edits, or the same key in
+// another section), or nothing.
+std::string suggestion(std::string_view name, const std::vector<std::string_view>& candidates,
+                       std::string_view before = "", std::string_view after = "") {
+  if (name.size() > kMaxSuggested) return "";
+  const size_t limit = std::clamp<size_t>(name.size() / 3, 1, 3);
+  std::string_view best;
+  size_t bestDistance = limit + 1;
+  for (std::string_view c : candidates) {
+    size_t d = distance(name, c);
+    if (d > 0 && distance(leaf(name), leaf(c)) == 0) d = std::min<size_t>(d, 1);
+    if (d < bestDistance) best = c, bestDistance = d;
+  }
+  if (best.empty()) return "";
+  return "; did you mean " + std::string(before) + std::string(best) + std::string(after) + "?";
+}
+
+// toml++ 3.3 reaches __builtin_unreachable() — undefined behaviour — when it asks whether some
+// non-ASCII characters are whitespace (marzer/tomlplusplus issues 190 and 295). TOML allows
+// non-ASCII text only in comments and strings, so this finds the first character elsewhere, or
+// where toml++ asks the same question inside a multi-line basic string (right after a backslash,
+// or first on a line after a line-ending one), before toml++ reads the text.
+struct Unsafe {
+  Place place;
+  const char* what;
+};
+
+std::optional<Unsafe> unsafeForToml(std::string_view text) {
+  enum class In { plain, comment, basic, literal, multiBasic, multiLiteral } in = In::plain;
+  auto byte = [&](size_t i) { return i < text.size() ? static_cast<unsigned char>(text[i]) : 0; };
+  auto blank = [](unsigned char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; };
+  // The length of the run of `quote` at i: three or more close a multi-line string (the extra
+  // ones, up to two, belong to its text).
+  auto run = [&](size_t i, char quote) {
+    size_t n = 0;
+    while (i + n < text.size() && text[i + n] == quote) ++n;
+    return n;
+  };
+  Place at{1, 0};
+  size_t i = text.starts_with("\xEF\xBB\xBF") ? 3 : 0;  // a byte-order mark, which toml++ skips
+  // Moves to byte j, counting lines and characters (not UTF-8 continuation bytes) on the way.
+  auto moveTo = [&](size_t j) {
+    for (; i < j && i < text.size(); ++i) {
+      if (text[i] == '\n')
+        at = {at.line + 1, 0};
+      else if ((byte(i) & 0xC0) != 0x80)
+        ++at.column;
+    }
+  };
+  while (i < text.size()) {
+    const unsigned char c = byte(i);
+    const size_t start = i;
+    moveTo(i + 1);
+    const Place here = at;
+    switch (in) {
+      case In::plain:
+        if (c >= 0x80) return Unsafe{here, "a non-ASCII character outside a string or comment"};
+        if (c == '#') in = In::comment;
+        if (c == '"' || c == '\'') {
+          const size_t n = run(start, static_cast<char>(c));
+          if (n >= 3) {
+            in = c == '"' ? In::multiBasic : In::multiLiteral;
+            moveTo(start + 3);
+          } else if (n == 2) {
+            moveTo(start + 2);  // an empty string
+          } else {
+            in = c == '"' ? In::basic : In::literal;
+          }
+        }
+        break;
+      case In::comment:
+        if (c == '\n') in = In::plain;
+        break;
+      case In::basic:
+        if (c == '\\') moveTo(start + 2);
+        if (c == '"' || c == '\n') in = In::plain;
+        break;
+      case In::literal:
+        if (c == '\'' || c == '\n') in = In::plain;
+        break;
+      case In::multiBasic:
+        if (c == '\\') {
+          size_t j = start + 1;
+          if (byte(j) >= 0x80) return Unsafe{here, "a non-ASCII character after a backslash"};
+          if (blank(byte(j))) {
+            while (blank(byte(j))) ++j;
+            if (byte(j) >= 0x80)
+              return Unsafe{here, "a non-ASCII character first after a line-ending backslash"};
+          } else {
+            ++j;  // an escaped character: \" does not end the string
+          }
+          moveTo(j);
+        } else if (c == '"' && run(start, '"') >= 3) {
+          moveTo(start + std::min<size_t>(run(start, '"'), 5));
+          in = In::plain;
+        }
+        break;
+      case In::multiLiteral:
+        if (c == '\'' && run(start, '\'') >= 3) {
+          moveTo(start + std::min<size_t>(run(start, '\''), 5));
+          in = In::plain;
+        }
+        break;
+    }
+  }
+  return std::nullopt;
+}
+
+// The sections of the table ("string", "hammer", …), not counting "key" (the anchors).
+std::vector<std::string_view> sections() {
+  std::vector<std::string_view> out;
+  for (const Parameter& p : parameters()) {
+    const std::string_view s = sectionOf(p.name);
+    if (!s.empty() && s != "key" && std::find(out.begin(), out.end(), s) == out.end())
+      out.push_back(s);
+  }
+  return out;
+}
+
+bool isSection(std::string_view name) {
+  const auto all = sections();
+  return std::find(all.begin(), all.end(), name) != all.end();
+}
+
+std::vector<std::string_view> keyNames(bool perKeyOnly) {
+  std::vector<std::string_view> out;
+  for (const Parameter& p : parameters())
+    if (sectionOf(p.name) != "key" && (!perKeyOnly || p.perKey)) out.push_back(p.name);
+  return out;
+}
+
+// A voice's complaint ("damper_t60_s = 0.001: must be …") names its field; this is the preset
+// parameter it comes from. `keep`: the voice's own "field = value" says more than the parameter's
+// value would (a derived quantity), so the whole message is kept.
+struct VoiceField {
+  std::string_view field, parameter;
+  bool keep = false;
+};
+
+constexpr VoiceField kStringFields[] = {
+    {"oversampling", "scheme.oversampling"},
+    {"a4_hz", "a4_Hz"},
+    {"damper_t60_s", "loss.damper_t60_s"},
+    {"pickup_position", "pickups.left_position"},
+    {"channels", "pickups.channels"},
+    {"gain", "pickups.gain"},
+    {"hammer_velocity_max_m_s", "hammer.velocity_max_m_s"},
+    {"velocity_curve", "hammer.velocity_curve"},
+    {"guard_energy_multiple", "scheme.guard_energy_multiple"},
+    {"epsilon_j", "scheme.epsilon_J"},
+    {"bend_range_semitones", "bend_range_semitones"},
+    {"tension scale range", "bend_range_semitones", true},
+    {"t60_low_s", "loss.t60_low_s"},
+    {"t60_high_s", "loss.t60_high_s"},
+    {"t60_high_hz", "loss.t60_high_Hz"},
+    {"tension", "string.tension_N"},
+    {"length", "string.length_m"},
+    {"young", "string.young_Pa"},
+    {"grid factor", "scheme.grid_factor"},
+    {"hammer mass", "hammer.mass_kg"},
+    {"hammer stiffness", "hammer.stiffness_N_per_m_p"},
+    {"hammer exponent", "hammer.exponent"},
+    {"hammer position", "hammer.position"},
+    {"hammer width", "hammer.width_m"},
+};
+
+constexpr VoiceField kPlateFields[] = {
+    {"oversampling", "scheme.oversampling"},
+    {"strike_position", "strike.position_x"},
+    {"strike_position_high", "strike.position_x_high"},
+    {"pickup_position", "pickups.left_x"},
+    {"strike_width_m", "strike.width_m"},
+    {"force_max_n", "strike.force_max_N"},
+    {"duration_max_s", "strike.duration_max_s"},
+    {"velocity_curve", "strike.velocity_curve"},
+    {"damper_t60_s", "loss.damper_t60_s"},
+    {"gain", "pickups.gain"},
+    {"guard_energy_multiple", "scheme.guard_energy_multiple"},
+    {"t60_low_s", "loss.t60_low_s"},
+    {"t60_high_s", "loss.t60_high_s"},
+    {"t60_high_hz", "loss.t60_high_Hz"},
+    {"grid points per side", "plate.lx_m", true},
+    {"plate side", "plate.lx_m", true},
+    {"grid factor", "scheme.grid_factor"},
+    {"young", "plate.young_Pa"},
+    {"density", "plate.density_kg_m3"},
+    {"thickness", "plate.thickness_m"},
+    {"lx", "plate.lx_m"},
+    {"ly", "plate.ly_m"},
+    {"poisson", "plate.poisson"},
+};
+
+class Loader {
+ public:
+  explicit Loader(std::string source) : source_(std::move(source)) {}
+  Instrument load(std::string_view text, const PresetOptions& options);
+
+ private:
+  void error(Place at, std::string message);
+  [[noreturn]] void fail();
+  void throwIfErrors() {
+    if (!errors_.empty() || dropped_ > 0) fail();
+  }
+
+  void readModel(const toml::table& root);
+  void readRoot(const toml::table& root);
+  void readSection(std::string_view section, const toml::table& table, Place at);
+  void readAnchors(const toml::node& node, Place at);
+  void readAnchor(const toml::table& table, size_t ordinal);
+  void entry(std::string name, const toml::node& value, Place at, Settings& into,
+             const std::string& label);
+  std::optional<Setting> convert(const Parameter& p, const toml::node& value, Place at,
+                                 const std::string& label);
+  void checkRequired();
+  void checkAnchors();
+  void checkBounds();
+  void checkBound(const Parameter& p, const Parameter& other, bool upper);
+  Instrument build() const;
+  void checkVoices(const Instrument& instrument);
+  void voiceError(std::string_view message, int note);
+
+  const Parameter& row(std::string_view name) const;
+  const Setting* setting(std::string_view name) const;
+  double number(std::string_view name) const;
+  std::string word(std::string_view name) const;
+  bool anchored(const Parameter& p) const;
+  double atKey(const Parameter& p, int note) const;
+  Blame blame(const Parameter& p, int note, bool sayNote) const;
+
+  std::string source_;
+  std::vector<std::pair<Place, std::string>> errors_;
+  size_t dropped_ = 0;
+  std::optional<InstrumentModel> model_;
+  Settings settings_;
+  std::set<std::string> seen_;          // names the file sets, valid or not
+  std::set<std::string_view> invalid_;  // parameters set somewhere to an invalid value
+  std::vector<Anchor> anchors_;         // by note once read
+  std::set<std::pair<Place, std::string_view>> voiceReported_;  // (setting, parameter)
+};
+
+void Loader::error(Place at, std::string message) {
+  if (errors_.size() >= kMaxKept) {
+    ++dropped_;
+    return;
+  }
+  errors_.emplace_back(at, std::move(message));
+}
+
+void Loader::fail() {
+  std::stable_sort(errors_.begin(), errors_.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  const size_t total = errors_.size() + dropped_;
+  const size_t shown = total > kMaxLines ? kMaxLines - 1 : total;
+  std::vector<std::string> lines;
+  for (size_t i = 0; i < shown; ++i)
+    lines.push_back(source_ + ":" + std::to_string(errors_[i].first.line) + ":" +
+                    std::to_string(errors_[i].first.column) + ": " + errors_[i].second);
+  if (shown < total)
+    lines.push_back(source_ + ": … and " + std::to_string(total - shown) + " more errors");
+  throw PresetError(std::move(lines));
+}
+
+Instrument Loader::load(std::string_view text, const PresetOptions& options) {
+  if (text.size() > kMaxBytes)
+    throw PresetError({source_ + ": " + std::to_string(text.size()) +
+                       " bytes: larger than the 1 MiB a preset may be"});
+  if (const auto unsafe = unsafeForToml(text)) {
+    error(unsafe->place, std::string("syntax error: ") + unsafe->what);
+    fail();
+  }
+  toml::table root;
+  try {
+    root = toml::parse(text, std::string_view(source_));
+  } catch (const toml::parse_error& e) {
+    error(placeOf(e.source()), "syntax error: " + std::string(e.description()));
+    fail();
+  }
+  readModel(root);
+  readRoot(root);
+  checkRequired();
+  checkAnchors();
+  checkBounds();
+  throwIfErrors();
+  Instrument instrument = build();
+  if (options.checkVoices) checkVoices(instrument);
+  throwIfErrors();
+  return instrument;
+}
+
+// The model decides which keys are valid, so it is read first; a bad one is reported with the
+// other keys.
+void Loader::readModel(const toml::table& root) {
+  if (const toml::node* model = root.get("model"); model && model->is_string()) {
+    if (model->as_string()->get() == "string") model_ = InstrumentModel::string;
+    if (model->as_string()->get() == "plate") model_ = InstrumentModel::plate;
+  }
+}
+
+void Loader::readRoot(const toml::table& root) {
+  for (auto&& [key, value] : root) {
+    const std::string name(key.str());
+    const Place at = placeOf(key.source());
+    if (name == "key")
+      readAnchors(value, at);
+    else if (!isSection(name))
+      entry(name, value, at, settings_, "");
+    else if (const toml::table* table = value.as_table())
+      readSection(name, *table, at);
+    else
+      error(at, name + " = " + show(value) + ": expected a table, [" + name + "]");
+  }
+}
+
+void Loader::readSection(std::string_view section, const toml::table& table, Place at) {
+  if (model_) {
+    const auto all = parameters();
+    const bool any = std::any_of(all.begin(), all.end(), [&](const Parameter& p) {
+      return sectionOf(p.name) == section && appliesTo(p, *model_);
+    });
+    if (!any) {
+      error(
+          at,
+          "[" + std::string(section) + "]: " +
+              std::string(modelName(*model_ == InstrumentModel::string ? InstrumentModel::plate
+                                                                       : InstrumentModel::string)) +
+              " model only; this preset's model is \"" + std::string(modelName(*model_)) + "\"");
+      return;
+    }
+  }
+  for (auto&& [key, value] : table)
+    entry(std::string(section) + "." + std::string(key.str()), value, placeOf(key.source()),
+          settings_, "");
+}
+
+void Loader::readAnchors(const toml::node& node, Place at) {
+  if (model_ == InstrumentModel::plate) {
+    error(at, "[[key]]: string model only; this preset's model is \"plate\"");
+    return;
+  }
+  const toml::array* list = node.as_array();
+  if (!list || !list->is_array_of_tables()) {
+    error(at, "key = " + show(node) + ": expected [[key]] anchor tables");
+    return;
+  }
+  if (list->size() > kMaxAnchors)
+    error(at, "[[key]]: " + std::to_string(list->size()) + " anchor tables; at most " +
+                  std::to_string(kMaxAnchors));
+  for (size_t i = 0; i < std::min(list->size(), kMaxAnchors); ++i)
+    readAnchor(*(*list)[i].as_table(), i + 1);
+  std::stable_sort(anchors_.begin(), anchors_.end(),
+                   [](const Anchor& a, const Anchor& b) { return a.note < b.note; });
+}
+
+void Loader::readAnchor(const toml::table& table, size_t ordinal) {
+  Anchor anchor;
+  std::string label = "key[" + std::to_string(ordinal) + "]";
+  bool valid = false;
+  for (auto&& [key, value] : table) {
+    if (key.str() != "note") continue;
+    anchor.place = placeOf(key.source());
+    if (auto note = convert(*findParameter("key.note"), value, anchor.place, label + ".note")) {
+      anchor.note = static_cast<int>(note->number);
+      anchor.shown = note->shown;
+      label = "key[" + noteName(anchor.note) + "]";
+      valid = true;
+      for (const Anchor& other : anchors_)
+        if (other.note == anchor.note) {
+          error(anchor.place, label + ".note = " + anchor.shown + ": duplicate anchor; " +
+                                  noteName(anchor.note) + " is already an anchor at line " +
+                                  std::to_string(other.place.line));
+          valid = false;
+        }
+    }
+  }
+  if (!table.contains("note"))
+    error(placeOf(table.source()),
+          label + ": missing note; each [[key]] table needs note = \"C4\" (or a MIDI number)");
+  for (auto&& [key, value] : table) {
+    const std::string name(key.str());
+    const Place at = placeOf(key.source());
+    if (name == "note") continue;
+    if (const toml::table* section = value.as_table(); section && isSection(name)) {
+      for (auto&& [subkey, subvalue] : *section)
+        entry(name + "." + std::string(subkey.str()), subvalue, placeOf(subkey.source()),
+              anchor.values, label);
+    } else {
+      entry(name, value, at, anchor.values, label);
+    }
+  }
+  if (valid) anchors_.push_back(std::move(anchor));
+}
+
+void Loader::entry(std::string name, const toml::node& value, Place at, Settings& into,
+                   const std::string& label) {
+  const std::string shownName = (label.empty() ? "" : label + ".") + clip(name, false);
+  const Parameter* any = findParameter(name);
+  if (!any || sectionOf(name) == "key") {
+    if (value.is_table()) {
+      std::vector<std::string_view> tables = sections();
+      tables.push_back("key");
+      error(at, "[" + shownName + "]: unknown table" + suggestion(name, tables, "[", "]"));
+    } else {
+      error(at, shownName + " = " + show(value) + ": unknown key" +
+                    suggestion(name, keyNames(!label.empty())));
+    }
+    return;
+  }
+  seen_.insert(name);
+  const Parameter* p = model_ ? findParameter(name, *model_) : any;
+  if (!p) {
+    error(at,
+          shownName + " = " + show(value) + ": " +
+              std::string(modelName(*model_ == InstrumentModel::string ? InstrumentModel::plate
+                                                                       : InstrumentModel::string)) +
+              " model only; this preset's model is \"" + std::string(modelName(*model_)) + "\"");
+    return;
+  }
+  if (!label.empty() && !p->perKey) {
+    const std::string_view section = sectionOf(p->name);
+    error(at, shownName + " = " + show(value) + ": not per-key; set it " +
+                  (section.empty() ? std::string("at the top level")
+                                   : "in [" + std::string(section) + "]"));
+    return;
+  }
+  if (auto s = convert(*p, value, at, shownName))
+    into[p->name] = std::move(*s);
+  else
+    invalid_.insert(p->name);
+}
+
+std::optional<Setting> Loader::convert(const Parameter& p, const toml::node& value, Place at,
+                                       const std::string& label) {
+  Setting s{.place = at, .shown = show(value)};
+  auto refuse = [&](const std::string& what) {
+    error(at, label + " = " + s.shown + ": " + what);
+    return std::nullopt;
+  };
+  switch (p.type) {
+    case ParameterType::real: {
+      double x = 0.0;
+      if (const auto* i = value.as_integer())
+        x = static_cast<double>(i->get());
+      else if (const auto* f = value.as_floating_point())
+        x = f->get();
+      else
+        return refuse("expected a number");
+      if (std::isnan(x) || (std::isinf(x) && (x > 0 ? p.max : -p.min) != INFINITY))
+        return refuse("not a finite number");
+      if (x < p.min || x > p.max) return refuse("out of range; expected " + rangeText(p));
+      s.number = x;
+      return s;
+    }
+    case ParameterType::integer: {
+      const auto* i = value.as_integer();
+      if (!i) return refuse("expected an integer");
+      const std::int64_t n = i->get();
+      if (!p.choices.empty() && !inChoices(p.choices, std::to_string(n)))
+        return refuse("expected " + listChoices(p.choices, false));
+      if (n < p.min || n > p.max) return refuse("out of range; expected " + rangeText(p));
+      s.number = static_cast<double>(n);
+      return s;
+    }
+    case ParameterType::choice: {
+      const auto* w = value.as_string();
+      if (!w || !inChoices(p.choices, w->get()))
+        return refuse("expected " + listChoices(p.choices, true));
+      s.word = w->get();
+      return s;
+    }
+    case ParameterType::boolean: {
+      const auto* b = value.as_boolean();
+      if (!b) return refuse("expected true or false");
+      s.number = b->get() ? 1.0 : 0.0;
+      return s;
+    }
+    case ParameterType::note: {
+      std::optional<int> n;
+      if (const auto* i = value.as_integer()) {
+        if (i->get() >= 0 && i->get() <= 127) n = static_cast<int>(i->get());
+      } else if (const auto* w = value.as_string()) {
+        n = parseNoteName(w->get());
+      }
+      if (!n) return refuse("expected a MIDI note 0 … 127 or a name like \"C4\"");
+      s.number = *n;
+      return s;
+    }
+    case ParameterType::text: {
+      const auto* w = value.as_string();
+      if (!w) return refuse("expected text in quotes");
+      if (w->get().size() > kMaxText)
+        return refuse("longer than " + std::to_string(kMaxText) + " bytes");
+      s.word = w->get();
+      return s;
+    }
+  }
+  return std::nullopt;
+}
+
+void Loader::checkRequired() {
+  for (const Parameter& p : parameters())
+    if (p.defaultKind == DefaultKind::required && sectionOf(p.name) != "key" &&
+        !seen_.count(std::string(p.name)) && (!model_ || appliesTo(p, *model_)))
+      error({}, std::string(p.name) + ": missing; expected " +
+                    (p.type == ParameterType::choice
+                         ? listChoices(p.choices, true)
+                         : std::string("a MIDI note 0 … 127 or a name like \"C4\"")));
+}
+
+void Loader::checkAnchors() {
+  const Setting* lowest = setting("lowest_note");
+  const Setting* highest = setting("highest_note");
+  if (!lowest || !highest) return;
+  const int lo = static_cast<int>(lowest->number), hi = static_cast<int>(highest->number);
+  for (const Anchor& a : anchors_)
+    if (a.note < lo || a.note > hi)
+      error(a.place, "key[" + noteName(a.note) + "].note = " + a.shown +
+                         ": outside lowest_note … highest_note, " + noteName(lo) + " … " +
+                         noteName(hi));
+}
+
+// The bounds one parameter puts on another (highest_note >= lowest_note, t60_high_s <=
+// t60_low_s, …), where both values are valid.
+void Loader::checkBounds() {
+  if (!setting("lowest_note") || !setting("highest_note")) return;
+  for (const Parameter& p : parameters()) {
+    if (p.minOf.empty() && p.maxOf.empty()) continue;
+    if (model_ ? !appliesTo(p, *model_) : p.model != ParameterModel::both) continue;
+    const bool upper = !p.maxOf.empty();
+    const Parameter& other = row(upper ? p.maxOf : p.minOf);
+    if (!invalid_.count(p.name) && !invalid_.count(other.name)) checkBound(p, other, upper);
+  }
+}
+
+void Loader::checkBound(const Parameter& p, const Parameter& other, bool upper) {
+  // Without anchors for either, both hold at every key: one comparison says all.
+  const bool perKey = anchored(p) || anchored(other);
+  const int lo = static_cast<int>(number("lowest_note"));
+  const int hi = perKey ? static_cast<int>(number("highest_note")) : lo;
+  // The one set in the file is blamed; with both set, the bounded one.
+  const bool blameP = setting(p.name) || anchored(p) || (!setting(other.name) && !anchored(other));
+  // The anchors' own notes first, so that an anchor's value is reported at its note.
+  std::vector<int> notes;
+  if (perKey)
+    for (const Anchor& a : anchors_)
+      if (a.values.count(p.name) || a.values.count(other.name)) notes.push_back(a.note);
+  for (int note = lo; note <= hi; ++note) notes.push_back(note);
+  std::set<Place> reported;
+  for (int note : notes) {
+    const double x = perKey ? atKey(p, note) : number(p.name);
+    const double y = perKey ? atKey(other, note) : number(other.name);
+    if (upper ? x <= y : x >= y) continue;
+    const Blame b = blame(blameP ? p : other, note, false);
+    if (!reported.insert(b.place).second) continue;
+    const std::string at = perKey ? " at " + noteName(note) : "";
+    const std::string bound =
+        approximate(blameP ? y : x) + " (" + std::string(blameP ? other.name : p.name) + at + ")";
+    std::string expected;
+    if (blameP)
+      expected =
+          upper ? compactNumber(p.min) + " … " + bound : bound + " … " + compactNumber(p.max);
+    else
+      expected = (upper ? "at least " : "at most ") + bound;
+    error(b.place, b.text + ": out of range; expected " + expected);
+  }
+}
+
+const Parameter& Loader::row(std::string_view name) const {
+  const Parameter* p = model_ ? findParameter(name, *model_) : findParameter(name);
+  if (!p) throw std::logic_error("preset loader: no parameter " + std::string(name));
+  return *p;
+}
+
+const Setting* Loader::setting(std::string_view name) const {
+  const auto it = settings_.find(name);
+  return it == settings_.end() ? nullptr : &it->second;
+}
+
+double Loader::number(std::string_view name) const {
+  if (const Setting* s = setting(name)) return s->number;
+  if (name == "plate.reference_note") return number("lowest_note");
+  return defaultNumber(row(name));
+}
+
+std::string Loader::word(std::string_view name) const {
+  if (const Setting* s = setting(name)) return s->word;
+  return std::string(row(name).defaultText);
+}
+
+bool Loader::anchored(const Parameter& p) const {
+  return std::any_of(anchors_.begin(), anchors_.end(),
+                     [&](const Anchor& a) { return a.values.count(p.name) > 0; });
+}
+
+// The value at `note`: the anchors that set the parameter define it (interpolated between them,
+// held beyond them); without any, the section's value or the default holds at every key.
+double Loader::atKey(const Parameter& p, int note) const {
+  const Anchor *below = nullptr, *above = nullptr;
+  for (const Anchor& a : anchors_) {
+    if (!a.values.count(p.name)) continue;
+    if (a.note <= note)
+      below = &a;
+    else if (!above)
+      above = &a;
+  }
+  if (!below && !above) return number(p.name);
+  if (!below) return above->values.at(p.name).number;
+  const double a = below->values.at(p.name).number;
+  if (!above || below->note == note || p.type == ParameterType::integer) return a;
+  const double b = above->values.at(p.name).number;
+  const double t = static_cast<double>(note - below->note) / (above->note - below->note);
+  if (p.min <= 0.0) return a + t * (b - a);
+  if (!std::isfinite(a) || !std::isfinite(b)) return INFINITY;
+  return a * std::pow(b / a, t);
+}
+
+// The setting behind p's value at `note`: the nearest anchor that sets it, the section's value,
+// or the default (at line 1).
+Blame Loader::blame(const Parameter& p, int note, bool sayNote) const {
+  const Anchor* nearest = nullptr;
+  for (const Anchor& a : anchors_)
+    if (a.values.count(p.name) &&
+        (!nearest || std::abs(a.note - note) < std::abs(nearest->note - note)))
+      nearest = &a;
+  const std::string at = " at " + noteName(note);
+  if (nearest && nearest->note == note)
+    return {nearest->values.at(p.name).place, "key[" + noteName(note) + "]." + std::string(p.name) +
+                                                  " = " + nearest->values.at(p.name).shown};
+  if (nearest)
+    return {nearest->values.at(p.name).place,
+            std::string(p.name) + " = " + approximate(atKey(p, note)) + at};
+  const Setting* s = setting(p.name);
+  const std::string value = s                                  ? s->shown
+                            : p.type == ParameterType::choice  ? "\"" + word(p.name) + "\""
+                            : p.type == ParameterType::boolean ? std::string(p.defaultText)
+                                                               : approximate(number(p.name));
+  return {s ? s->place : Place{}, std::string(p.name) + " = " + value + (sayNote ? at : "")};
+}
+
+Instrument Loader::build() const {
+  Instrument instrument;
+  instrument.source = source_;
+  instrument.name = setting("name") ? word("name") : std::filesystem::path(source_).stem().string();
+  instrument.model = *model_;
+  instrument.lowestNote = static_cast<int>(number("lowest_note"));
+  instrument.highestNote = static_cast<int>(number("highest_note"));
+  instrument.polyphony = static_cast<int>(number("polyphony"));
+  instrument.gainDb = number("gain_dB");
+  instrument.panSpread = number("pan_spread");
+  const PickupSignal signal =
+      word("pickups.signal") == "velocity" ? PickupSignal::velocity : PickupSignal::displacement;
+  if (*model_ == InstrumentModel::plate) {
+    PlatePatch& p = instrument.plate;
+    p.plate = {.young = number("plate.young_Pa"),
+               .density = number("plate.density_kg_m3"),
+               .poisson = number("plate.poisson"),
+               .thickness = number("plate.thickness_m"),
+               .lx = number("plate.lx_m"),
+               .ly = number("plate.ly_m")};
+    p.referenceNote = static_cast<int>(number("plate.reference_note"));
+    p.lowestNote = instrument.lowestNote;
+    p.highestNote = instrument.highestNote;
+    p.gridFactor = number("scheme.grid_factor");
+    p.oversampling = static_cast<int>(number("scheme.oversampling"));
+    p.t60Low = number("loss.t60_low_s");
+    p.t60High = number("loss.t60_high_s");
+    p.t60HighHz = number("loss.t60_high_Hz");
+    p.damperT60 = number("loss.damper_t60_s");
+    p.strike[0] = number("strike.position_x");
+    p.strike[1] = number("strike.position_y");
+    p.strikeWidth = number("strike.width_m");
+    p.forceMax = number("strike.force_max_N");
+    p.durationMin = number("strike.duration_min_s");
+    p.durationMax = number("strike.duration_max_s");
+    p.velocityCurve = number("strike.velocity_curve");
+    p.noteMovesStrike = number("strike.note_moves_strike") != 0.0;
+    p.strikeHigh[0] = number("strike.position_x_high");
+    p.strikeHigh[1] = number("strike.position_y_high");
+    p.pickups[0][0] = number("pickups.left_x");
+    p.pickups[0][1] = number("pickups.left_y");
+    p.pickups[1][0] = number("pickups.right_x");
+    p.pickups[1][1] = number("pickups.right_y");
+    p.signal = signal;
+    p.gain = number("pickups.gain");
+    p.guardEnergyMultiple = number("scheme.guard_energy_multiple");
+    return instrument;
+  }
+
+  instrument.bendRange = number("bend_range_semitones");
+  StringPatch common;
+  common.tuneBy = word("string.tune_by") == "tension" ? TuneBy::tension : TuneBy::length;
+  common.a4Hz = number("a4_Hz");
+  common.grid =
+      word("scheme.grid_rule") == "transverse" ? GridRule::transverse : GridRule::longitudinal;
+  common.gridFactor = number("scheme.grid_factor");
+  common.oversampling = static_cast<int>(number("scheme.oversampling"));
+  common.epsilon = number("scheme.epsilon_J");
+  common.t60HighHz = number("loss.t60_high_Hz");
+  common.pickups[0] = number("pickups.left_position");
+  common.pickups[1] = number("pickups.right_position");
+  common.channels = static_cast<int>(number("pickups.channels"));
+  common.signal = signal;
+  common.gain = number("pickups.gain");
+  common.velocityMin = number("hammer.velocity_min_m_s");
+  common.velocityMax = number("hammer.velocity_max_m_s");
+  common.velocityCurve = number("hammer.velocity_curve");
+  common.guardEnergyMultiple = number("scheme.guard_energy_multiple");
+  common.bendRange = instrument.bendRange;
+  common.hammer.width = number("hammer.width_m");
+  common.string.young = number("string.young_Pa");
+  const bool stiff = number("string.bending_stiffness") != 0.0;
+  const Parameter& linearDensity = row("string.linear_density_kg_m");
+  const bool densityGiven = setting(linearDensity.name) || anchored(linearDensity);
+
+  for (int note = instrument.lowestNote; note <= instrument.highestNote; ++note) {
+    auto at = [&](std::string_view name) { return atKey(row(name), note); };
+    StringKey key{.patch = common};
+    StringPatch& p = key.patch;
+    const double d = at("string.diameter_m");
+    p.string.area = std::numbers::pi * d * d / 4.0;
+    p.string.density =
+        densityGiven ? at(linearDensity.name) / p.string.area : number("string.density_kg_m3");
+    p.string.length = at("string.length_m");
+    p.string.tension = at("string.tension_N");
+    p.string.inertia = stiff ? std::numbers::pi * std::pow(d, 4) / 64.0 : 0.0;
+    p.hammer.mass = at("hammer.mass_kg");
+    p.hammer.stiffness = at("hammer.stiffness_N_per_m_p");
+    p.hammer.exponent = at("hammer.exponent");
+    p.hammer.position = at("hammer.position");
+    p.t60Low = at("loss.t60_low_s");
+    p.t60High = at("loss.t60_high_s");
+    p.damperT60 = at("loss.damper_t60_s");
+    key.unisons = static_cast<int>(at("string.unisons"));
+    key.detuneCents = at("string.detune_cents");
+    instrument.keys.push_back(key);
+  }
+  return instrument;
+}
+
+void Loader::checkVoices(const Instrument& instrument) {
+  const int lo = instrument.lowestNote, hi = instrument.highestNote;
+  std::set<int> notes{lo, hi};
+  if (instrument.model == InstrumentModel::plate) {
+    const int reference = instrument.plate.referenceNote;
+    if (reference >= lo && reference <= hi) notes.insert(reference);
+    for (int note : notes) try {
+        PlateVoice voice;
+        voice.prepare(instrument.plate, note, kCheckRate);
+      } catch (const std::exception& e) {
+        voiceError(e.what(), note);
+      }
+    return;
+  }
+  for (int note = lo; note <= hi; note += 12) notes.insert(note);
+  for (const Anchor& a : anchors_) notes.insert(a.note);
+  for (int note : notes) try {
+      StringVoice voice;
+      voice.prepare(instrument.keys[note - lo].patch, note, kCheckRate);
+    } catch (const std::exception& e) {
+      voiceError(e.what(), note);
+    }
+}
+
+// Points the voice's complaint at the setting behind the field it names, once per setting.
+void Loader::voiceError(std::string_view message, int note) {
+  const size_t colon = message.find(": ");
+  const std::string_view head = message.substr(0, colon);
+  const std::string_view field = head.substr(0, head.find(" = "));
+  const VoiceField* found = nullptr;
+  if (*model_ == InstrumentModel::string) {
+    for (const VoiceField& f : kStringFields)
+      if (f.field == field) found = &f;
+  } else {
+    for (const VoiceField& f : kPlateFields)
+      if (f.field == field) found = &f;
+  }
+  if (!found) {
+    const Setting* edge = note == number("lowest_note")    ? setting("lowest_note")
+                          : note == number("highest_note") ? setting("highest_note")
+                                                           : nullptr;
+    error(edge ? edge->place : Place{},
+          noteName(note) + " (" + std::to_string(note) + "): " + std::string(message));
+    return;
+  }
+  const Blame b = blame(row(found->parameter), note, true);
+  if (!voiceReported_.emplace(b.place, found->parameter).second) return;
+  const std::string_view rest =
+      found->keep || colon == std::string_view::npos ? message : message.substr(colon + 2);
+  error(b.place, b.text + ": " + std::string(rest));
+}
+
+}  // namespace
+
+PresetError::PresetError(std::vector<std::string> messages)
+    : std::runtime_error([&] {
+        std::string joined;
+        for (const std::string& line : messages) joined += (joined.empty() ? "" : "\n") + line;
+        return joined;
+      }()),
+      lines(std::move(messages)) {}
+
+Instrument loadPreset(const std::filesystem::path& file) {
+  const std::string name = file.string();
+  std::error_code error;
+  if (!std::filesystem::exists(file, error))
+    throw PresetError({name + ": cannot read: no such file"});
+  if (!std::filesystem::is_regular_file(file, error))
+    throw PresetError({name + ": cannot read: not a regular file"});
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw PresetError({name + ": cannot open the file"});
+  std::string text(kMaxBytes + 1, '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  if (in.bad()) throw PresetError({name + ": cannot read the file"});
+  text.resize(static_cast<size_t>(in.gcount()));
+  return parsePreset(text, name);
+}
+
+Instrument parsePreset(std::string_view text, const std::string& sourceName,
+                       const PresetOptions& options) {
+  return Loader(sourceName).load(text, options);
+}
+
+}  // namespace hamiltone

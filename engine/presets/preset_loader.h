@@ -1,0 +1,43 @@
+// Preset files: the TOML description of an instrument (every key is a row of parameters.h), read,
+// checked against the parameter table and against the voices themselves, and built into an
+// Instrument — or refused with every problem found, one line each.
+#pragma once
+
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "synth/instrument.h"
+
+namespace hamiltone {
+
+// Everything wrong with a preset, one line per problem, in file order:
+//   FILE:LINE:COL: key = value: what is valid
+// e.g. "presets/x.toml:12:1: string.tension_n = 759: unknown key; did you mean string.tension_N?".
+// what() is the lines joined with '\n'.
+struct PresetError : std::runtime_error {
+  explicit PresetError(std::vector<std::string> messages);
+  std::vector<std::string> lines;
+};
+
+struct PresetOptions {
+  // Prepare a voice for some keys and report what it refuses (a tuning with no solution, a grid
+  // too coarse for the string or too fine for the plate): the lowest, the highest, every 12th key
+  // from the lowest and every anchor of a string instrument; the lowest, reference and highest
+  // note of a plate. Made at 48 kHz, a few milliseconds a key (a large plate's more): a voice
+  // prepared at another rate can still refuse a patch this check passed.
+  bool checkVoices = true;
+};
+
+// Reads `file` (at most 1 MiB) and parses it; its path, as given, names it in the messages.
+// Throws PresetError.
+Instrument loadPreset(const std::filesystem::path& file);
+
+// The work of loadPreset on text already read. Never crashes or hangs on any input: anything but
+// a valid preset throws PresetError (at most 100 lines, the last saying how many more there were).
+Instrument parsePreset(std::string_view text, const std::string& sourceName,
+                       const PresetOptions& options = {});
+
+}  // namespace hamiltone

@@ -1,0 +1,437 @@
+// The preset loader and its parameter table: the bundled presets load as their data say, every
+// broken fixture gives exactly its error lines, per-key values follow their anchors, and the
+// table is consistent with itself and with the voices' defaults.
+#include "presets/preset_loader.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <iterator>
+#include <numbers>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "presets/parameters.h"
+#include "presets/piano_scale.h"
+
+namespace hamiltone {
+namespace {
+
+using ::testing::ElementsAre;
+using ::testing::HasSubstr;
+
+std::string sourcePath(const std::string& relative) {
+  return std::string(HAMILTONE_SOURCE_DIR) + "/" + relative;
+}
+
+// The lines of the PresetError that loading `file` throws (none if it loads).
+std::vector<std::string> errorsOf(const std::string& file) {
+  try {
+    loadPreset(file);
+  } catch (const PresetError& e) {
+    return e.lines;
+  }
+  return {};
+}
+
+std::vector<std::string> errorsOfText(const std::string& text, const PresetOptions& options = {}) {
+  try {
+    parsePreset(text, "test.toml", options);
+  } catch (const PresetError& e) {
+    return e.lines;
+  }
+  return {};
+}
+
+// Whether `word` is one of the '|'-separated `choices`.
+bool listed(std::string_view choices, std::string_view word) {
+  size_t start = 0;
+  while (true) {
+    const size_t bar = choices.find('|', start);
+    if (choices.substr(start, bar - start) == word) return true;
+    if (bar == std::string_view::npos) return false;
+    start = bar + 1;
+  }
+}
+
+const std::string kStringHead = "model = \"string\"\nlowest_note = \"C2\"\nhighest_note = \"C4\"\n";
+
+TEST(PresetLoader, BundledPresetsLoadAsTheirDataSay) {
+  const Instrument piano = loadPreset(sourcePath("presets/grand-piano.toml"));
+  EXPECT_EQ(piano.model, InstrumentModel::string);
+  EXPECT_EQ(piano.lowestNote, 21);
+  EXPECT_EQ(piano.highestNote, 108);
+  ASSERT_EQ(piano.keys.size(), 88u);
+  // Data §1.4: single strings A0–E1, bichords F1–A1, trichords from A#1.
+  for (int note = 21; note <= 108; ++note)
+    EXPECT_EQ(piano.keys[note - 21].unisons, note <= 28 ? 1 : note <= 33 ? 2 : 3) << note;
+  EXPECT_DOUBLE_EQ(piano.keys[48 - 21].detuneCents, 2.64);  // data §3.2, C3
+  EXPECT_DOUBLE_EQ(piano.keys[48 - 21].patch.damperT60, 0.63);
+
+  const Instrument paper = loadPreset(sourcePath("presets/paper-c3-string.toml"));
+  EXPECT_EQ(paper.model, InstrumentModel::string);
+  EXPECT_EQ(paper.lowestNote, 42);
+  EXPECT_EQ(paper.highestNote, 54);
+  for (const StringKey& key : paper.keys) EXPECT_EQ(key.unisons, 1);
+
+  struct PlateRange {
+    const char* file;
+    int lowest, highest;
+  };
+  for (const PlateRange& p :
+       {PlateRange{"presets/steel-plate.toml", 27, 39}, PlateRange{"presets/gong.toml", 36, 48},
+        PlateRange{"presets/thunder-sheet.toml", 36, 40},
+        PlateRange{"presets/small-cymbal.toml", 60, 72}}) {
+    const Instrument plate = loadPreset(sourcePath(p.file));
+    EXPECT_EQ(plate.model, InstrumentModel::plate) << p.file;
+    EXPECT_EQ(plate.lowestNote, p.lowest) << p.file;
+    EXPECT_EQ(plate.highestNote, p.highest) << p.file;
+    EXPECT_EQ(plate.plate.lowestNote, p.lowest) << p.file;
+    EXPECT_EQ(plate.plate.highestNote, p.highest) << p.file;
+    EXPECT_TRUE(plate.keys.empty()) << p.file;
+  }
+}
+
+// The preset's anchors are piano_scale.cpp's and interpolate the same way: every key's string
+// agrees with pianoString() to roundoff.
+TEST(PresetLoader, GrandPianoStringsAreThePianoScale) {
+  const Instrument piano = loadPreset(sourcePath("presets/grand-piano.toml"));
+  for (int note = 21; note <= 108; ++note) {
+    const StringPhysics& got = piano.keys[note - 21].patch.string;
+    const StringPhysics want = pianoString(note);
+    EXPECT_NEAR(got.length, want.length, 1e-12 * want.length) << note;
+    EXPECT_NEAR(got.area, want.area, 1e-12 * want.area) << note;
+    EXPECT_NEAR(got.density, want.density, 1e-12 * want.density) << note;
+    EXPECT_NEAR(got.tension, want.tension, 1e-12 * want.tension) << note;
+    EXPECT_NEAR(got.inertia, want.inertia, 1e-12 * want.inertia) << note;
+    EXPECT_EQ(got.young, want.young) << note;
+  }
+}
+
+TEST(PresetLoader, PaperPresetsHoldThePaperParameters) {
+  const Instrument string = loadPreset(sourcePath("presets/paper-c3-string.toml"));
+  const StringPhysics& s = string.keys[48 - 42].patch.string;  // BDZ §4.2, C3
+  EXPECT_NEAR(s.area, 8.87e-7, 1e-6 * 8.87e-7);
+  EXPECT_EQ(s.density, 7850.0);
+  EXPECT_EQ(s.length, 1.259);
+  EXPECT_EQ(s.young, 2.02e11);
+  EXPECT_EQ(s.tension, 759.0);
+  EXPECT_EQ(s.inertia, 0.0);
+
+  const Instrument plate = loadPreset(sourcePath("presets/steel-plate.toml"));  // BDZ §4.3.3
+  EXPECT_EQ(plate.plate.plate.young, 2e11);
+  EXPECT_EQ(plate.plate.plate.density, 7850.0);
+  EXPECT_EQ(plate.plate.plate.poisson, 0.3);
+  EXPECT_EQ(plate.plate.plate.thickness, 2e-3);
+  EXPECT_EQ(plate.plate.plate.lx, 0.5);
+  EXPECT_EQ(plate.plate.plate.ly, 0.5);
+  EXPECT_EQ(plate.plate.referenceNote, 27);
+}
+
+struct Fixture {
+  const char* file;
+  std::vector<std::string> lines;  // after "<path>:"
+};
+
+TEST(PresetLoader, BrokenFixturesGiveExactlyTheirErrors) {
+  const std::vector<Fixture> fixtures = {
+      {"bad-unknown-key.toml",
+       {"7:1: string.tension_n = 759: unknown key; did you mean string.tension_N?"}},
+      {"bad-type.toml", {"7:1: hammer.exponent = \"hard\": expected a number"}},
+      {"bad-range.toml",
+       {"7:1: string.unisons = 4: out of range; expected 1 … 3",
+        "11:1: loss.t60_high_s = 50: out of range; expected 0.01 … 20 (loss.t60_low_s)"}},
+      {"bad-nonfinite.toml",
+       {"5:1: gain_dB = nan: not a finite number",
+        "11:1: hammer.mass_kg = inf: not a finite number"}},
+      {"bad-unstable.toml",
+       {"8:1: string.length_m = 0.02 at C3: shorter than two grid spacings h = "
+        "0.010323762951830734 m at k = 2.0833333333333333e-05 s (stiff-string bound (44)); use "
+        "a smaller time step (oversampling) or a smaller grid factor"}},
+      {"bad-syntax.toml",
+       {"2:16: syntax error: Error while parsing string: unescaped control characters other "
+        "than TAB (U+0009) are explicitly prohibited"}},
+      {"bad-several.toml",
+       {"1:1: highest_note: missing; expected a MIDI note 0 … 127 or a name like \"C4\"",
+        "6:1: plate.thickness_m = \"thin\": expected a number",
+        "8:2: [hammer]: string model only; this preset's model is \"plate\""}},
+  };
+  for (const Fixture& f : fixtures) {
+    const std::string path = sourcePath(std::string("tests/data/presets/") + f.file);
+    std::vector<std::string> want;
+    for (const std::string& line : f.lines) want.push_back(path + ":" + line);
+    EXPECT_EQ(errorsOf(path), want) << f.file;
+  }
+}
+
+TEST(PresetLoader, ErrorNamesTheAnchorAndTheModel) {
+  EXPECT_THAT(errorsOfText(kStringHead + "[[key]]\nnote = \"C3\"\nhammer.width_m = 0.01\n"),
+              ElementsAre("test.toml:6:8: key[C3].hammer.width_m = 0.01: not per-key; set it in "
+                          "[hammer]"));
+  EXPECT_THAT(errorsOfText(kStringHead + "[[key]]\nnote = \"C3\"\n[[key]]\nnote = 48\n"),
+              ElementsAre("test.toml:7:1: key[C3].note = 48: duplicate anchor; C3 is already an "
+                          "anchor at line 5"));
+  EXPECT_THAT(errorsOfText(kStringHead + "[[key]]\nnote = \"C5\"\n"),
+              ElementsAre("test.toml:5:1: key[C5].note = \"C5\": outside lowest_note … "
+                          "highest_note, C2 … C4"));
+  EXPECT_THAT(errorsOfText(kStringHead + "[[key]]\nstring.length_m = 1\n"),
+              ElementsAre("test.toml:4:1: key[1]: missing note; each [[key]] table needs note = "
+                          "\"C4\" (or a MIDI number)"));
+  EXPECT_THAT(errorsOfText("model = \"plate\"\nlowest_note = 40\nhighest_note = 41\n"
+                           "[pickups]\nchannels = 1\n[stirke]\nwidth_m = 1\n"),
+              ElementsAre("test.toml:5:1: pickups.channels = 1: string model only; this "
+                          "preset's model is \"plate\"",
+                          "test.toml:6:2: [stirke]: unknown table; did you mean [strike]?"));
+  EXPECT_THAT(errorsOfText("lowest_note = 40\nhighest_note = 41\n"),
+              ElementsAre("test.toml:1:1: model: missing; expected \"string\" or \"plate\""));
+}
+
+// toml++ 3.3 has undefined behaviour on some non-ASCII characters where TOML expects
+// whitespace; the loader refuses them first. Comments and strings may hold any text.
+TEST(PresetLoader, NonAsciiOnlyInCommentsAndStrings) {
+  EXPECT_THAT(errorsOfText("model = \"string\"\nx = 1 \xC3\xA9\n"),
+              ElementsAre("test.toml:2:7: syntax error: a non-ASCII character outside a string or "
+                          "comment"));
+  EXPECT_THAT(errorsOfText("s = \"\"\"\\\n  \xC2\xA7\"\"\"\n"),
+              ElementsAre("test.toml:1:8: syntax error: a non-ASCII character first after a "
+                          "line-ending backslash"));
+  const Instrument i = parsePreset(
+      "# Gong — §4\nname = \"Gong — §4\"\nmodel = \"plate\"\nlowest_note = 40\n"
+      "highest_note = 41\n",
+      "test.toml");
+  EXPECT_EQ(i.name, "Gong — §4");
+}
+
+// A parameter's own bound is checked key by key where anchors make it vary.
+TEST(PresetLoader, CrossFieldBoundsHoldAtEveryKey) {
+  EXPECT_THAT(errorsOfText(kStringHead + "[loss]\nt60_low_s = 5\n[[key]]\nnote = \"C4\"\n"
+                                         "loss.t60_high_s = 6\n"),
+              ElementsAre("test.toml:8:6: key[C4].loss.t60_high_s = 6: out of range; expected "
+                          "0.01 … 5 (loss.t60_low_s at C4)"));
+  EXPECT_THAT(errorsOfText(kStringHead + "[hammer]\nvelocity_min_m_s = 8\n"),
+              ElementsAre("test.toml:5:1: hammer.velocity_min_m_s = 8: out of range; expected "
+                          "at most 6 (hammer.velocity_max_m_s)"));
+}
+
+TEST(PresetLoader, AnchorsScaleGeometricallyLinearlyOrStepwise) {
+  const Instrument i = parsePreset(kStringHead +
+                                       "[string]\nlength_m = 1.5\n"
+                                       "[[key]]\nnote = \"C2\"\nstring.length_m = 2.0\n"
+                                       "string.detune_cents = 0\nstring.unisons = 1\n"
+                                       "[[key]]\nnote = \"C3\"\nstring.detune_cents = 10\n"
+                                       "[[key]]\nnote = \"C4\"\nstring.length_m = 0.5\n"
+                                       "string.unisons = 3\n",
+                                   "test.toml");
+  auto key = [&](int note) { return i.keys[note - 36]; };
+  EXPECT_NEAR(key(36).patch.string.length, 2.0, 1e-15);
+  EXPECT_NEAR(key(48).patch.string.length, 1.0, 1e-15);  // geometric mean of 2 and 0.5
+  EXPECT_NEAR(key(42).patch.string.length, std::sqrt(2.0), 1e-15);
+  EXPECT_NEAR(key(42).detuneCents, 5.0, 1e-15);   // linear: detune may be 0
+  EXPECT_NEAR(key(60).detuneCents, 10.0, 1e-15);  // held beyond the last anchor setting it
+  EXPECT_EQ(key(59).unisons, 1);                  // an integer holds from its anchor up
+  EXPECT_EQ(key(60).unisons, 3);
+  // A parameter no anchor sets keeps the section's value everywhere; so does the density.
+  EXPECT_EQ(key(50).patch.string.density, 7850.0);
+}
+
+TEST(PresetLoader, LinearDensityMakesTheEquivalentPlainString) {
+  const Instrument i = parsePreset(kStringHead +
+                                       "[string]\ndiameter_m = 1.48e-3\n"
+                                       "linear_density_kg_m = 99.413e-3\n",
+                                   "test.toml");
+  const StringPhysics& s = i.keys[0].patch.string;
+  const double area = std::numbers::pi * 1.48e-3 * 1.48e-3 / 4.0;
+  EXPECT_NEAR(s.area, area, 1e-15 * area);
+  EXPECT_NEAR(s.linearDensity(), 99.413e-3, 1e-15);  // data §1.5: ρA with the winding
+  EXPECT_NEAR(s.inertia, std::numbers::pi * std::pow(1.48e-3, 4) / 64.0, 1e-24);
+}
+
+// A file that sets only what is required gets the voices' own defaults.
+TEST(PresetLoader, DefaultsAreTheVoicesDefaults) {
+  const Instrument s =
+      parsePreset("model = \"string\"\nlowest_note = 48\nhighest_note = 48\n", "test.toml");
+  const StringPatch& got = s.keys[0].patch;
+  const StringPatch want;
+  EXPECT_NEAR(got.string.area, want.string.area, 1e-6 * want.string.area);
+  EXPECT_EQ(got.string.density, want.string.density);
+  EXPECT_EQ(got.string.length, want.string.length);
+  EXPECT_EQ(got.string.young, want.string.young);
+  EXPECT_EQ(got.string.tension, want.string.tension);
+  EXPECT_EQ(got.hammer.mass, want.hammer.mass);
+  EXPECT_EQ(got.hammer.stiffness, want.hammer.stiffness);
+  EXPECT_EQ(got.hammer.exponent, want.hammer.exponent);
+  EXPECT_EQ(got.hammer.position, want.hammer.position);
+  EXPECT_EQ(got.hammer.width, want.hammer.width);
+  EXPECT_EQ(got.tuneBy, want.tuneBy);
+  EXPECT_EQ(got.a4Hz, want.a4Hz);
+  EXPECT_EQ(got.grid, want.grid);
+  EXPECT_EQ(got.gridFactor, want.gridFactor);
+  EXPECT_EQ(got.oversampling, want.oversampling);
+  EXPECT_EQ(got.epsilon, want.epsilon);
+  EXPECT_EQ(got.t60Low, want.t60Low);
+  EXPECT_EQ(got.t60High, want.t60High);
+  EXPECT_EQ(got.t60HighHz, want.t60HighHz);
+  EXPECT_EQ(got.damperT60, want.damperT60);
+  EXPECT_EQ(got.pickups[0], want.pickups[0]);
+  EXPECT_EQ(got.pickups[1], want.pickups[1]);
+  EXPECT_EQ(got.channels, want.channels);
+  EXPECT_EQ(got.signal, want.signal);
+  EXPECT_EQ(got.gain, want.gain);
+  EXPECT_EQ(got.velocityMin, want.velocityMin);
+  EXPECT_EQ(got.velocityMax, want.velocityMax);
+  EXPECT_EQ(got.velocityCurve, want.velocityCurve);
+  EXPECT_EQ(got.guardEnergyMultiple, want.guardEnergyMultiple);
+  EXPECT_EQ(got.bendRange, want.bendRange);
+  const Instrument defaults;
+  EXPECT_EQ(s.polyphony, defaults.polyphony);
+  EXPECT_EQ(s.gainDb, defaults.gainDb);
+  EXPECT_EQ(s.panSpread, defaults.panSpread);
+  EXPECT_EQ(s.bendRange, defaults.bendRange);
+  EXPECT_EQ(s.name, "test");
+
+  const Instrument p =
+      parsePreset("model = \"plate\"\nlowest_note = 48\nhighest_note = 50\n", "test.toml");
+  const PlatePatch& plate = p.plate;
+  const PlatePatch wantPlate;
+  EXPECT_EQ(plate.plate.young, wantPlate.plate.young);
+  EXPECT_EQ(plate.plate.density, wantPlate.plate.density);
+  EXPECT_EQ(plate.plate.poisson, wantPlate.plate.poisson);
+  EXPECT_EQ(plate.plate.thickness, wantPlate.plate.thickness);
+  EXPECT_EQ(plate.plate.lx, wantPlate.plate.lx);
+  EXPECT_EQ(plate.plate.ly, wantPlate.plate.ly);
+  EXPECT_EQ(plate.referenceNote, 48);  // the lowest note
+  EXPECT_EQ(plate.gridFactor, wantPlate.gridFactor);
+  EXPECT_EQ(plate.oversampling, wantPlate.oversampling);
+  EXPECT_EQ(plate.t60Low, wantPlate.t60Low);
+  EXPECT_EQ(plate.t60High, wantPlate.t60High);
+  EXPECT_EQ(plate.t60HighHz, wantPlate.t60HighHz);
+  EXPECT_EQ(plate.damperT60, wantPlate.damperT60);
+  EXPECT_EQ(plate.strike[0], wantPlate.strike[0]);
+  EXPECT_EQ(plate.strike[1], wantPlate.strike[1]);
+  EXPECT_EQ(plate.strikeWidth, wantPlate.strikeWidth);
+  EXPECT_EQ(plate.forceMax, wantPlate.forceMax);
+  EXPECT_EQ(plate.durationMin, wantPlate.durationMin);
+  EXPECT_EQ(plate.durationMax, wantPlate.durationMax);
+  EXPECT_EQ(plate.velocityCurve, wantPlate.velocityCurve);
+  EXPECT_EQ(plate.noteMovesStrike, wantPlate.noteMovesStrike);
+  EXPECT_EQ(plate.strikeHigh[0], wantPlate.strikeHigh[0]);
+  EXPECT_EQ(plate.strikeHigh[1], wantPlate.strikeHigh[1]);
+  for (int c = 0; c < 2; ++c)
+    for (int d = 0; d < 2; ++d) EXPECT_EQ(plate.pickups[c][d], wantPlate.pickups[c][d]);
+  EXPECT_EQ(plate.signal, wantPlate.signal);
+  EXPECT_EQ(plate.gain, wantPlate.gain);
+  EXPECT_EQ(plate.guardEnergyMultiple, wantPlate.guardEnergyMultiple);
+}
+
+TEST(PresetLoader, VoiceCheckCanBeLeftOut) {
+  const std::string path = sourcePath("tests/data/presets/bad-unstable.toml");
+  EXPECT_FALSE(errorsOf(path).empty());
+  std::ifstream in(path);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_TRUE(errorsOfText(text, {.checkVoices = false}).empty());
+}
+
+TEST(PresetLoader, RefusesWhatItCannotRead) {
+  EXPECT_THAT(errorsOf(sourcePath("tests/data/presets/no-such-file.toml")),
+              ElementsAre(HasSubstr("no-such-file.toml: cannot read: no such file")));
+  EXPECT_THAT(errorsOf(sourcePath("tests/data/presets")),
+              ElementsAre(HasSubstr("presets: cannot read: not a regular file")));
+  EXPECT_THAT(errorsOfText(std::string((1 << 20) + 1, '#')),
+              ElementsAre("test.toml: 1048577 bytes: larger than the 1 MiB a preset may be"));
+}
+
+// 300 unknown keys: 99 lines and one that counts the rest.
+TEST(PresetLoader, CapsTheErrorLines) {
+  std::string text = kStringHead;
+  for (int i = 0; i < 300; ++i) text.append("unknown").append(std::to_string(i)).append(" = 1\n");
+  const std::vector<std::string> lines = errorsOfText(text);
+  ASSERT_EQ(lines.size(), 100u);
+  EXPECT_EQ(lines.back(), "test.toml: … and 201 more errors");
+}
+
+TEST(PresetParameters, DefaultsSatisfyTheirOwnRanges) {
+  for (const Parameter& p : parameters()) {
+    if (p.defaultKind != DefaultKind::value) continue;
+    switch (p.type) {
+      case ParameterType::real:
+      case ParameterType::integer:
+      case ParameterType::note: {
+        const double v = defaultNumber(p);
+        EXPECT_GE(v, p.min) << p.name;
+        EXPECT_LE(v, p.max) << p.name;
+        if (p.type != ParameterType::real) {
+          EXPECT_EQ(v, std::round(v)) << p.name;
+        }
+        if (!p.choices.empty()) {
+          EXPECT_TRUE(listed(p.choices, p.defaultText)) << p.name;
+        }
+        break;
+      }
+      case ParameterType::choice:
+        EXPECT_TRUE(listed(p.choices, p.defaultText)) << p.name;
+        break;
+      case ParameterType::boolean:
+        EXPECT_TRUE(p.defaultText == "true" || p.defaultText == "false") << p.name;
+        break;
+      case ParameterType::text:
+        ADD_FAILURE() << p.name << ": a text parameter's default is derived";
+        break;
+    }
+    if (!p.minOf.empty()) {
+      const Parameter* other = findParameter(p.minOf);
+      ASSERT_NE(other, nullptr) << p.name;
+      EXPECT_GE(defaultNumber(p), defaultNumber(*other)) << p.name;
+    }
+    if (!p.maxOf.empty()) {
+      for (InstrumentModel m : {InstrumentModel::string, InstrumentModel::plate}) {
+        const Parameter* other = findParameter(p.maxOf, m);
+        if (appliesTo(p, m) && other) {
+          EXPECT_LE(defaultNumber(p), defaultNumber(*other)) << p.name;
+        }
+      }
+    }
+  }
+}
+
+TEST(PresetParameters, PerKeyParametersAreStringNumbers) {
+  for (const Parameter& p : parameters())
+    if (p.perKey) {
+      EXPECT_EQ(p.model, ParameterModel::string) << p.name;
+      EXPECT_TRUE(p.type == ParameterType::real || p.type == ParameterType::integer) << p.name;
+    }
+}
+
+TEST(PresetParameters, PrintedTableListsEveryParameterIn100Columns) {
+  const std::string table = parameterTable();
+  for (const Parameter& p : parameters()) EXPECT_THAT(table, HasSubstr(std::string(p.name)));
+  size_t start = 0;
+  while (start < table.size()) {
+    const size_t end = table.find('\n', start);
+    const std::string line = table.substr(start, end - start);
+    size_t columns = 0;
+    for (unsigned char c : line) columns += (c & 0xC0) != 0x80;
+    EXPECT_LE(columns, 100u) << line;
+    start = end == std::string::npos ? table.size() : end + 1;
+  }
+}
+
+TEST(PresetNotes, NamesAndNumbers) {
+  EXPECT_EQ(parseNoteName("A0"), 21);
+  EXPECT_EQ(parseNoteName("C4"), 60);
+  EXPECT_EQ(parseNoteName("c4"), 60);
+  EXPECT_EQ(parseNoteName("C#4"), 61);
+  EXPECT_EQ(parseNoteName("Db4"), 61);
+  EXPECT_EQ(parseNoteName("C-1"), 0);
+  EXPECT_EQ(parseNoteName("G9"), 127);
+  for (const char* bad : {"", "C", "H3", "G#9", "Cb-1", "C10", "C+4", "C#", "4C", "C 4"})
+    EXPECT_EQ(parseNoteName(bad), std::nullopt) << bad;
+  for (int note = 0; note <= 127; ++note) EXPECT_EQ(parseNoteName(noteName(note)), note);
+  EXPECT_EQ(noteName(61), "C#4");
+}
+
+}  // namespace
+}  // namespace hamiltone
