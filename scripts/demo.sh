@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # README command 1: install what is missing, build, and run the main job on bundled defaults —
-# the Fermi–Pasta–Ulam test of BDZ §4.1 with each scheme, printing its energy drift.
+# render the bundled demo (presets/demo.mid, written by scripts/make-demo-midi.py) on the
+# grand-piano preset to demo.wav.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -9,8 +10,5 @@ cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release \
       -DHAMILTONE_BUILD_TESTS=OFF -DHAMILTONE_BUILD_BENCH=OFF >/dev/null
 cmake --build build/release
 
-mkdir -p out
-for scheme in sv sav sav-split marazzato; do
-  build/release/render/hamiltone-sim fpu --scheme "$scheme" --alpha 100 --k 1e-3 --duration 1 \
-      --out "out/fpu-$scheme.csv"
-done
+build/release/render/hamiltone-render --preset presets/grand-piano.toml \
+    --midi presets/demo.mid -o demo.wav

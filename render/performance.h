@@ -1,0 +1,28 @@
+// Renders a performance — MIDI messages at times in seconds — through the synthesizer into a
+// WAV file, block by block, with events at their exact samples.
+#pragma once
+
+#include <functional>
+#include <vector>
+
+#include "midi/midi_message.h"
+#include "synth/synth.h"
+#include "wav_writer.h"
+
+namespace hamiltone::cli {
+
+struct RenderStats {
+  double seconds = 0.0;      // of audio written
+  double wallSeconds = 0.0;  // taken
+  int guardEvents = 0;       // voices the guard silenced
+  long nonFinite = 0;        // samples the master replaced
+  float peak = 0.0f;         // largest |sample| written
+};
+
+// Renders `seconds` of audio: messages (sorted by time) applied at round(t · rate), in blocks of
+// `block` frames. `progress` is called after each block with the seconds rendered so far.
+RenderStats renderPerformance(Synth& synth, const std::vector<TimedMessage>& messages,
+                              double seconds, int block, double sampleRate, WavWriter& out,
+                              const std::function<void(double)>& progress);
+
+}  // namespace hamiltone::cli

@@ -1,0 +1,168 @@
+// hamiltone-render: plays a MIDI file or a --notes list on presets and writes a WAV file.
+#include <CLI/App.hpp>
+#include <CLI/Config.hpp>
+#include <CLI/Formatter.hpp>
+#include <CLI/Validators.hpp>
+#include <cstdio>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "midi/midi_file.h"
+#include "note_list.h"
+#include "number_arguments.h"
+#include "performance.h"
+#include "presets/parameters.h"
+#include "presets/preset_loader.h"
+#include "progress_bar.h"
+#include "usage_error.h"
+
+namespace hamiltone::cli {
+namespace {
+
+struct RenderArguments {
+  std::vector<std::string> presets;
+  std::string midi, notes, out, format = "pcm24";
+  std::string sampleRate = "48000", tail = "3", voices, block = "256";
+  bool quiet = false, listParams = false;
+};
+
+SampleFormat sampleFormat(const std::string& name) {
+  if (name == "pcm16") return SampleFormat::pcm16;
+  if (name == "float32") return SampleFormat::float32;
+  return SampleFormat::pcm24;
+}
+
+int run(const RenderArguments& a) {
+  if (a.listParams) {
+    std::fputs(parameterTable().c_str(), stdout);
+    return 0;
+  }
+  if (a.midi.empty() == a.notes.empty())
+    throw UsageError("give exactly one of --midi FILE or --notes LIST");
+  if (a.out.empty()) throw UsageError("-o FILE: the WAV file to write is required");
+  const double rate = static_cast<double>(parseInteger("--sample-rate", a.sampleRate, 8000, 384000));
+  const double tail = parseReal("--tail", a.tail, Range::nonNegative, " seconds");
+  if (tail > 600.0) throw UsageError("--tail = " + a.tail + ": at most 600 seconds");
+  const int block = static_cast<int>(parseInteger("--block", a.block, 1, 8192));
+  const int voices = a.voices.empty() ? 0 : static_cast<int>(parseInteger("--voices", a.voices, 1, 128));
+
+  // Everything is read and checked before the output file is created.
+  std::vector<Instrument> instruments;
+  const std::vector<std::string> files =
+      a.presets.empty() ? std::vector<std::string>{HAMILTONE_DEFAULT_PRESET} : a.presets;
+  std::string presetErrors;
+  for (const std::string& file : files) {
+    try {
+      instruments.push_back(loadPreset(file));
+    } catch (const PresetError& e) {
+      presetErrors += e.what();
+      presetErrors += '\n';
+    }
+  }
+  if (!presetErrors.empty()) {
+    presetErrors.pop_back();
+    throw UsageError("bad preset:\n" + presetErrors);
+  }
+  std::vector<TimedMessage> messages;
+  double end = 0.0;
+  if (!a.midi.empty()) {
+    try {
+      MidiFile file = readMidiFile(a.midi);
+      messages = std::move(file.messages);
+      end = file.lengthSeconds;
+    } catch (const MidiFileError& e) {
+      throw UsageError(std::string("--midi: ") + e.what());
+    }
+  } else {
+    NoteList list = parseNoteList(a.notes);
+    messages = std::move(list.messages);
+    end = list.endSeconds;
+  }
+  std::vector<bool> notes(128, false);
+  for (const TimedMessage& m : messages)
+    if (m.message.kind() == midi::noteOn) notes[m.message.data1 & 0x7F] = true;
+
+  Synth synth;
+  try {
+    synth.prepare(std::move(instruments),
+                  {.sampleRate = rate, .maxBlock = block, .notes = std::move(notes)});
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("preset does not build at this sample rate: ") + e.what());
+  }
+  synth.setPolyphony(voices);
+
+  WavWriter out(a.out, "-o", static_cast<int>(rate), 2, sampleFormat(a.format));
+  const double seconds = end + tail;
+  ProgressBar bar(seconds, progressWanted(a.quiet));
+  const RenderStats stats =
+      renderPerformance(synth, messages, seconds, block, rate, out,
+                        [&](double done) { bar.update(done); });
+  bar.finish();
+  out.commit();
+  if (!a.quiet) {
+    std::fprintf(stderr, "hamiltone-render: %s: %s\n", a.out.c_str(),
+                 renderSummary(stats.seconds, stats.wallSeconds).c_str());
+  }
+  if (stats.guardEvents > 0 || stats.nonFinite > 0)
+    std::fprintf(stderr,
+                 "hamiltone-render: warning: the guard silenced %d voice(s) and %ld non-finite "
+                 "sample(s) were zeroed: the preset is unstable for these notes\n",
+                 stats.guardEvents, stats.nonFinite);
+  return 0;
+}
+
+}  // namespace
+}  // namespace hamiltone::cli
+
+int main(int argc, char** argv) {
+  using namespace hamiltone::cli;
+  CLI::App app{
+      "hamiltone-render: plays a MIDI file or a list of notes on Hamiltone's physical models and "
+      "writes a stereo WAV file."};
+  RenderArguments a;
+  app.add_option("--preset", a.presets,
+                 "instrument preset (TOML); repeat it to load several, chosen by MIDI program "
+                 "change (0 = the first). Default: " HAMILTONE_DEFAULT_PRESET)
+      ->type_name("FILE");
+  app.add_option("--midi", a.midi, "Standard MIDI File (format 0 or 1) to play")->type_name("FILE");
+  app.add_option("--notes", a.notes,
+                 "notes to play: NOTE[@START][:VELOCITY[:DURATION]], comma-separated, e.g. "
+                 "\"C3:100:2.0, E3@0.5:90:1.5\" (C4 = MIDI 60; START 0, VELOCITY 100 and "
+                 "DURATION 1 s by default)")
+      ->type_name("LIST");
+  app.add_option("-o,--out", a.out, "WAV file to write (replaced whole, or untouched on error)")
+      ->type_name("FILE");
+  addNumberOption(&app, "--sample-rate", a.sampleRate, "HZ", "sample rate, 8000 … 384000");
+  app.add_option("--format", a.format, "sample format")
+      ->check(CLI::IsMember({"pcm16", "pcm24", "float32"}))
+      ->capture_default_str();
+  addNumberOption(&app, "--tail", a.tail, "SECONDS", "rendered after the last event, 0 … 600");
+  addNumberOption(&app, "--voices", a.voices, "N",
+                  "polyphony, 1 … 128 (default: the preset's)");
+  addNumberOption(&app, "--block", a.block, "FRAMES", "processing block, 1 … 8192");
+  app.add_flag("--quiet", a.quiet, "no progress bar and no summary");
+  app.add_flag("--list-params", a.listParams,
+               "print every preset parameter (name, type, unit, range, default) and exit");
+  app.footer(
+      "Exit codes: 0 done, 1 an I/O error (no file is left), 2 bad input (arguments, preset or "
+      "MIDI file; no file is written), 128+N killed by signal N (no file left).");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "hamiltone-render: %s (see hamiltone-render --help)\n", e.what());
+    return kExitUsage;
+  }
+  try {
+    return run(a);
+  } catch (const UsageError& e) {
+    std::fprintf(stderr, "hamiltone-render: %s\n", e.what());
+    return kExitUsage;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "hamiltone-render: error: %s\n", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,192 @@
+// hamiltone-render as a user meets it: the WAV it writes (rate, channels, format, length), the
+// pitch of rendered notes measured from the file, and bad input refused with no file written.
+#include <gtest/gtest.h>
+#include <sndfile.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Result {
+  int exitCode;
+  std::string err;
+};
+
+struct Wav {
+  SF_INFO info{};
+  std::vector<float> samples;  // interleaved
+};
+
+class RenderCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("hamiltone-render-" + std::to_string(::getpid()) + "-" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  Result run(const std::string& args) {
+    const fs::path err = dir_ / "stderr";
+    const std::string cmd = std::string(HAMILTONE_RENDER) + " " + args + " >/dev/null 2>" +
+                            err.string() + " </dev/null";
+    const int status = std::system(cmd.c_str());
+    std::ifstream in(err);
+    std::stringstream s;
+    s << in.rdbuf();
+    fs::remove(err);
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, s.str()};
+  }
+
+  static Wav read(const fs::path& path) {
+    Wav wav;
+    SNDFILE* f = sf_open(path.c_str(), SFM_READ, &wav.info);
+    if (!f) return wav;
+    wav.samples.resize(static_cast<size_t>(wav.info.frames * wav.info.channels));
+    sf_readf_float(f, wav.samples.data(), wav.info.frames);
+    sf_close(f);
+    return wav;
+  }
+
+  std::string wav() const { return (dir_ / "out.wav").string(); }
+
+  // Exit 2, the message mentions `mention`, and neither the WAV nor a temporary is left.
+  void expectRefused(const std::string& args, const std::string& mention) {
+    const Result r = run(args + " -o " + wav());
+    EXPECT_EQ(r.exitCode, 2) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find(mention), std::string::npos) << args << "\nstderr: " << r.err;
+    for (const auto& entry : fs::directory_iterator(dir_))  // the inputs may be there, no WAV
+      EXPECT_EQ(entry.path().filename().string().find("out.wav"), std::string::npos) << args;
+  }
+
+  fs::path dir_;
+};
+
+std::string preset(const char* name) {
+  return std::string(HAMILTONE_SOURCE_DIR) + "/presets/" + name + ".toml";
+}
+
+// |Σ w[n] x[n] e^{−iωn}| of the left channel, Hann window w.
+double magnitude(const std::vector<double>& x, double hz, double rate) {
+  double re = 0.0, im = 0.0;
+  const double n = static_cast<double>(x.size());
+  for (size_t i = 0; i < x.size(); ++i) {
+    const double w = 0.5 - 0.5 * std::cos(2.0 * std::numbers::pi * i / n);
+    const double phase = 2.0 * std::numbers::pi * hz * i / rate;
+    re += w * x[i] * std::cos(phase);
+    im -= w * x[i] * std::sin(phase);
+  }
+  return std::hypot(re, im);
+}
+
+// The spectral peak within ±30 cents of `expected`, by golden-section search: for a partial
+// isolated from its neighbours (an octave away) the Hann-windowed peak sits on its frequency.
+double peakFrequency(const std::vector<double>& x, double expected, double rate) {
+  double a = expected * std::pow(2.0, -30.0 / 1200.0), b = expected * std::pow(2.0, 30.0 / 1200.0);
+  const double g = (std::sqrt(5.0) - 1.0) / 2.0;
+  for (int i = 0; i < 60; ++i) {
+    const double c = b - g * (b - a), d = a + g * (b - a);
+    if (magnitude(x, c, rate) > magnitude(x, d, rate))
+      b = d;
+    else
+      a = c;
+  }
+  return 0.5 * (a + b);
+}
+
+TEST_F(RenderCli, WritesTheRequestedRateChannelsFormatAndLength) {
+  const Result r = run("--preset " + preset("paper-c3-string") +
+                       " --notes C3:100:0.5 --tail 0.25 --sample-rate 44100 --format pcm16 "
+                       "--quiet -o " + wav());
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(r.err, "");  // --quiet
+  const Wav w = read(wav());
+  EXPECT_EQ(w.info.samplerate, 44100);
+  EXPECT_EQ(w.info.channels, 2);
+  EXPECT_EQ(w.info.format, SF_FORMAT_WAV | SF_FORMAT_PCM_16);
+  EXPECT_EQ(w.info.frames, std::lround(0.75 * 44100));
+  for (const char* format : {"pcm24", "float32"}) {
+    ASSERT_EQ(run("--preset " + preset("paper-c3-string") + " --notes C3 --tail 0 --format " +
+                  format + " -o " + wav()).exitCode, 0);
+    const Wav f = read(wav());
+    EXPECT_EQ(f.info.format & SF_FORMAT_SUBMASK,
+              std::string(format) == "pcm24" ? SF_FORMAT_PCM_24 : SF_FORMAT_FLOAT);
+    EXPECT_EQ(f.info.frames, 48000);
+  }
+}
+
+// C3, A4 and C6 of the grand piano, played softly (little pitch glide), measured from the file:
+// the unison strings sit symmetrically around the note, so the peak of their sum is on it.
+TEST_F(RenderCli, RenderedNotesAreInTuneWithinOneCent) {
+  const struct {
+    const char* name;
+    double hz;
+  } notes[] = {{"C3", 130.8128}, {"A4", 440.0}, {"C6", 1046.502}};
+  for (const auto& note : notes) {
+    const Result r = run("--preset " + preset("grand-piano") + " --notes " + note.name +
+                         ":30:2 --tail 0 --quiet -o " + wav());
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    const Wav w = read(wav());
+    std::vector<double> left;
+    for (sf_count_t i = 24000; i < w.info.frames; ++i) left.push_back(w.samples[2 * i]);
+    const double measured = peakFrequency(left, note.hz, 48000.0);
+    EXPECT_NEAR(1200.0 * std::log2(measured / note.hz), 0.0, 1.0) << note.name;
+  }
+}
+
+TEST_F(RenderCli, PlaysTheBundledDemoMidiFile) {
+  const Result r = run("--preset " + preset("paper-c3-string") + " --midi " +
+                       HAMILTONE_SOURCE_DIR "/presets/demo.mid --tail 0.5 --block 1000 -o " + wav());
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.err.find("real-time factor"), std::string::npos) << r.err;
+  const Wav w = read(wav());
+  EXPECT_GT(w.info.frames, 10 * 48000);
+}
+
+TEST_F(RenderCli, RefusesBadInputAndWritesNothing) {
+  const std::string c3 = " --preset " + preset("paper-c3-string");
+  expectRefused(c3, "--midi");                                   // neither --midi nor --notes
+  expectRefused(c3 + " --notes C3 --midi x.mid", "exactly one");  // both
+  expectRefused(c3 + " --notes H3", "unknown note name");
+  expectRefused(c3 + " --notes C3 --sample-rate 1000", "--sample-rate");
+  expectRefused(c3 + " --notes C3 --tail -1", "--tail");
+  expectRefused(c3 + " --notes C3 --voices 0", "--voices");
+  expectRefused(c3 + " --notes C3 --block 0", "--block");
+  expectRefused(c3 + " --midi " + (dir_ / "missing.mid").string(), "missing.mid");
+  std::ofstream(dir_ / "junk.mid") << "MThd junk";
+  expectRefused(c3 + " --midi " + (dir_ / "junk.mid").string(), "junk.mid");
+  fs::remove(dir_ / "junk.mid");
+  std::ofstream(dir_ / "bad.toml") << "model = \"string\"\nbogus_key = 1\n";
+  expectRefused(" --preset " + (dir_ / "bad.toml").string() + " --notes C3", "bad.toml:2:1");
+  fs::remove(dir_ / "bad.toml");
+  // An unwritable output path fails before any work, naming -o.
+  const Result r = run(c3 + " --notes C3 -o /proc/hamiltone/out.wav");
+  EXPECT_EQ(r.exitCode, 2) << r.err;
+  EXPECT_NE(r.err.find("-o"), std::string::npos) << r.err;
+}
+
+TEST_F(RenderCli, ListsTheParameterTable) {
+  const std::string out = (dir_ / "params.txt").string();
+  const int status = std::system((std::string(HAMILTONE_RENDER) + " --list-params >" + out).c_str());
+  ASSERT_EQ(WEXITSTATUS(status), 0);
+  std::ifstream in(out);
+  std::stringstream s;
+  s << in.rdbuf();
+  EXPECT_NE(s.str().find("string.tension_N"), std::string::npos);
+  EXPECT_NE(s.str().find("polyphony"), std::string::npos);
+}
+
+}  // namespace
