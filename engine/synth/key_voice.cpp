@@ -20,6 +20,10 @@ void KeyVoice::prepare(const Instrument& instrument, int note, double sampleRate
           key.unisons == 1 ? 0.0 : key.detuneCents * (s / (key.unisons - 1.0) - 0.5);
       StringPatch patch = key.patch;
       patch.a4Hz *= std::pow(2.0, cents / 1200.0);
+      // One hammer strikes all the unisons: each string gets a share of its mass and felt
+      // stiffness, which is the same hammer exactly while the strings move alike (F = K δ^p).
+      patch.hammer.mass /= key.unisons;
+      patch.hammer.stiffness /= key.unisons;
       patch.bendRange = instrument.bendRange;
       strings[s].prepare(patch, note, sampleRate);
     }
