@@ -9,6 +9,7 @@ packages=(
   libcli11-dev        # render/: hamiltone-sim's and hamiltone-render's command lines
   libtomlplusplus-dev # engine/presets: the TOML preset files
   libsndfile1-dev     # render/: hamiltone-render's WAV output
+  librtaudio-dev librtmidi-dev  # app/: hamiltone-play's audio output and MIDI input
   libgtest-dev libgmock-dev  # tests/
   clang libclang-rt-14-dev   # tests/fuzz: libFuzzer targets for the MIDI reader and preset loader
   libbenchmark-dev    # bench/

@@ -67,6 +67,11 @@ const KeyVoice* Synth::voice(int program, int note) const {
   return const_cast<Synth*>(this)->keyVoice(program, note);
 }
 
+void Synth::setPolyphony(int voices) noexcept {
+  polyphonyOverride_ = std::max(voices, 0);
+  while (activeVoices() > polyphony()) stealOne();
+}
+
 int Synth::polyphony() const {
   return polyphonyOverride_ > 0 ? polyphonyOverride_ : instruments_[program_].polyphony;
 }
@@ -85,15 +90,16 @@ int Synth::guardEvents() const {
   return events;
 }
 
-// Released keys first (neither held nor sustained), then any; the quietest of them by the peak of
-// their latest block, the oldest on a tie. It fades out over 5 ms.
+// Released keys first (neither held nor sustained), the oldest of them, as they have decayed
+// longest; else the quietest held key by the peak of its latest block, the oldest on a tie. It
+// fades out over 5 ms.
 void Synth::stealOne() noexcept {
   KeyVoice* victim = nullptr;
   auto better = [&](const KeyVoice& v) {
     if (!victim) return true;
     const bool free = !v.down && !v.sustained, victimFree = !victim->down && !victim->sustained;
     if (free != victimFree) return free;
-    if (v.lastPeak() != victim->lastPeak()) return v.lastPeak() < victim->lastPeak();
+    if (!free && v.lastPeak() != victim->lastPeak()) return v.lastPeak() < victim->lastPeak();
     return v.order() < victim->order();
   };
   for (auto& keys : voices_)

@@ -47,8 +47,9 @@ class Synth {
                std::span<const SynthEvent> events) noexcept;
   void handle(const MidiMessage& message) noexcept;  // now, between two samples
 
-  // The limit on sounding keys; 0 restores the instrument's own polyphony.
-  void setPolyphony(int voices) noexcept { polyphonyOverride_ = voices; }
+  // The limit on sounding keys; 0 restores the instrument's own polyphony. Keys beyond a lowered
+  // limit fade out at once (released keys first, the oldest of them; then the quietest).
+  void setPolyphony(int voices) noexcept;
   int polyphony() const;
   int activeVoices() const;
   int program() const { return program_; }

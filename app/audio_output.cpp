@@ -1,0 +1,145 @@
+// AudioOutput on RtAudio 5: API by name, devices by index, a float32 interleaved stereo stream,
+// underflows counted, and every RtAudioError turned into an AudioError that says what exists.
+#include "audio_output.h"
+
+#include <RtAudio.h>
+
+#include <atomic>
+
+#include "quiet_stderr.h"
+
+namespace hamiltone::app {
+
+struct AudioOutput::Impl {
+  std::unique_ptr<RtAudio> audio;
+  Render render;
+  std::atomic<long> underruns{0};
+};
+
+namespace {
+
+int callback(void* out, void*, unsigned frames, double, RtAudioStreamStatus status, void* user) {
+  auto* impl = static_cast<AudioOutput::Impl*>(user);
+  const bool underrun = (status & RTAUDIO_OUTPUT_UNDERFLOW) != 0;
+  if (underrun) impl->underruns.fetch_add(1, std::memory_order_relaxed);
+  impl->render(static_cast<float*>(out), static_cast<int>(frames), underrun);
+  return 0;
+}
+
+std::string joined(const std::vector<std::string>& names) {
+  std::string s;
+  for (const std::string& n : names) s += (s.empty() ? "" : ", ") + n;
+  return s.empty() ? "none" : s;
+}
+
+std::string deviceList(const std::vector<AudioDevice>& devices) {
+  std::string s;
+  for (const AudioDevice& d : devices)
+    s += (s.empty() ? "" : "; ") + std::to_string(d.id) + ": " + d.name +
+         (d.isDefault ? " (default)" : "");
+  return s.empty() ? "none" : s;
+}
+
+}  // namespace
+
+std::vector<std::string> AudioOutput::compiledApis() {
+  std::vector<RtAudio::Api> apis;
+  RtAudio::getCompiledApi(apis);
+  std::vector<std::string> names;
+  for (RtAudio::Api api : apis)
+    if (api != RtAudio::RTAUDIO_DUMMY) names.push_back(RtAudio::getApiName(api));
+  return names;
+}
+
+AudioOutput::AudioOutput(const std::string& api) : impl_(std::make_unique<Impl>()), api_(api) {
+  const RtAudio::Api id = RtAudio::getCompiledApiByName(api);
+  if (id == RtAudio::UNSPECIFIED || id == RtAudio::RTAUDIO_DUMMY)
+    throw AudioError("audio API \"" + api +
+                     "\" is not available; this build has: " + joined(compiledApis()));
+  try {
+    const QuietStderr quiet;
+    impl_->audio = std::make_unique<RtAudio>(id);
+    impl_->audio->showWarnings(false);
+  } catch (const RtAudioError& e) {
+    throw AudioError("audio API " + api + ": " + e.getMessage());
+  }
+}
+
+AudioOutput::~AudioOutput() {
+  try {
+    stop();
+    if (impl_->audio && impl_->audio->isStreamOpen()) impl_->audio->closeStream();
+  } catch (const RtAudioError&) {
+  }
+}
+
+std::vector<AudioDevice> AudioOutput::devices() {
+  std::vector<AudioDevice> list;
+  const QuietStderr quiet;  // probing a device that is busy or gone prints through ALSA/JACK
+  try {
+    const unsigned count = impl_->audio->getDeviceCount();
+    for (unsigned i = 0; i < count; ++i) {
+      const RtAudio::DeviceInfo info = impl_->audio->getDeviceInfo(i);
+      if (!info.probed || info.outputChannels < 1) continue;
+      list.push_back({static_cast<int>(i), info.name, static_cast<int>(info.outputChannels),
+                      info.isDefaultOutput});
+    }
+  } catch (const RtAudioError&) {
+  }
+  return list;
+}
+
+int AudioOutput::resolve(int device) {
+  const std::vector<AudioDevice> available = devices();
+  if (available.empty())
+    throw AudioError("no audio output device for API " + api_ +
+                     (api_ == "jack" ? " (is a JACK server running?)" : "") +
+                     "; APIs in this build: " + joined(compiledApis()));
+  int chosen = device;
+  if (chosen < 0) {
+    chosen = available.front().id;
+    for (const AudioDevice& d : available)
+      if (d.isDefault) chosen = d.id;
+  }
+  for (const AudioDevice& d : available)
+    if (d.id == chosen) return chosen;
+  throw AudioError("--device " + std::to_string(device) + ": no such output device for API " +
+                   api_ + "; devices: " + deviceList(available));
+}
+
+void AudioOutput::open(int device, unsigned sampleRate, unsigned& bufferFrames, Render render) {
+  const int chosen = resolve(device);
+  impl_->render = std::move(render);
+  RtAudio::StreamParameters out;
+  out.deviceId = static_cast<unsigned>(chosen);
+  out.nChannels = 2;
+  RtAudio::StreamOptions options;
+  options.streamName = "hamiltone";
+  options.flags = RTAUDIO_SCHEDULE_REALTIME;
+  try {
+    const QuietStderr quiet;
+    impl_->audio->openStream(&out, nullptr, RTAUDIO_FLOAT32, sampleRate, &bufferFrames, &callback,
+                             impl_.get(), &options);
+  } catch (const RtAudioError& e) {
+    throw AudioError("cannot open device " + std::to_string(chosen) + " of API " + api_ + " at " +
+                     std::to_string(sampleRate) + " Hz: " + e.getMessage() +
+                     "; devices: " + deviceList(devices()));
+  }
+}
+
+void AudioOutput::start() {
+  try {
+    impl_->audio->startStream();
+  } catch (const RtAudioError& e) {
+    throw AudioError("cannot start the audio stream: " + e.getMessage());
+  }
+}
+
+void AudioOutput::stop() {
+  if (impl_->audio && impl_->audio->isStreamOpen() && impl_->audio->isStreamRunning())
+    impl_->audio->stopStream();
+}
+
+long AudioOutput::underruns() const { return impl_->underruns.load(); }
+
+}  // namespace hamiltone::app

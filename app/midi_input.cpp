@@ -1,0 +1,106 @@
+// MidiInput on RtMidi 5: the port, the arrival callback (on RtMidi's own thread) that keeps only
+// channel voice messages, and errors that name the ports there are.
+#include "midi_input.h"
+
+#include <RtMidi.h>
+
+#include <chrono>
+
+#include "quiet_stderr.h"
+
+namespace hamiltone::app {
+
+std::int64_t steadyNanoseconds() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+struct MidiInput::Impl {
+  std::unique_ptr<RtMidiIn> in;
+  bool open = false;  // a port and the callback are set
+};
+
+MidiInput::MidiInput(const std::string& api) : impl_(std::make_unique<Impl>()) {
+  const RtMidi::Api id = RtMidi::getCompiledApiByName(api == "pulse" ? "alsa" : api);
+  if (id == RtMidi::UNSPECIFIED || id == RtMidi::RTMIDI_DUMMY)
+    throw MidiError("MIDI API \"" + api + "\" is not available in this build");
+  try {
+    const QuietStderr quiet;
+    impl_->in = std::make_unique<RtMidiIn>(id, "hamiltone");
+    impl_->in->ignoreTypes(true, true, true);  // sysex, clock/timing, active sensing
+  } catch (const RtMidiError& e) {
+    throw MidiError("MIDI input on " + api + ": " + e.getMessage());
+  }
+}
+
+MidiInput::~MidiInput() { close(); }
+
+std::vector<std::string> MidiInput::ports() {
+  std::vector<std::string> names;
+  const QuietStderr quiet;
+  try {
+    const unsigned count = impl_->in->getPortCount();
+    for (unsigned i = 0; i < count; ++i) names.push_back(impl_->in->getPortName(i));
+  } catch (const RtMidiError&) {
+  }
+  return names;
+}
+
+void MidiInput::openPort(int port) {
+  const std::vector<std::string> names = ports();
+  if (port < 0 || port >= static_cast<int>(names.size())) {
+    std::string list;
+    for (size_t i = 0; i < names.size(); ++i)
+      list += (i ? "; " : "") + std::to_string(i) + ": " + names[i];
+    throw MidiError("--midi-port " + std::to_string(port) +
+                    ": no such MIDI input port; ports: " + (list.empty() ? "none" : list));
+  }
+  try {
+    const QuietStderr quiet;
+    impl_->in->setCallback(&MidiInput::arrived, this);
+    impl_->in->openPort(static_cast<unsigned>(port), "hamiltone-in");
+    impl_->open = true;
+  } catch (const RtMidiError& e) {
+    throw MidiError("cannot open MIDI port " + std::to_string(port) + ": " + e.getMessage());
+  }
+}
+
+void MidiInput::openVirtualPort(const std::string& name) {
+  try {
+    const QuietStderr quiet;
+    impl_->in->setCallback(&MidiInput::arrived, this);
+    impl_->in->openVirtualPort(name);
+    impl_->open = true;
+  } catch (const RtMidiError& e) {
+    throw MidiError("cannot create the virtual MIDI port \"" + name + "\": " + e.getMessage());
+  }
+}
+
+void MidiInput::close() {
+  if (!impl_->in || !impl_->open) return;
+  const QuietStderr quiet;
+  try {
+    impl_->in->closePort();
+    impl_->in->cancelCallback();
+  } catch (const RtMidiError&) {
+  }
+  impl_->open = false;
+}
+
+// RtMidi's thread: channel voice messages (0x80–0xEF, whole) into the queue; anything else —
+// system common, a stray data byte — is left out.
+void MidiInput::arrived(double, std::vector<unsigned char>* bytes, void* self) {
+  auto* input = static_cast<MidiInput*>(self);
+  if (bytes->empty()) return;
+  const unsigned status = (*bytes)[0];
+  if (status < 0x80 || status > 0xEF) return;
+  const size_t length = (status & 0xF0) == 0xC0 || (status & 0xF0) == 0xD0 ? 2 : 3;
+  if (bytes->size() < length) return;
+  StampedMessage m{steadyNanoseconds(),
+                   {static_cast<std::uint8_t>(status), (*bytes)[1],
+                    length == 3 ? (*bytes)[2] : std::uint8_t{0}}};
+  if (!input->queue_.push(m)) input->dropped_.fetch_add(1, std::memory_order_relaxed);
+}
+
+}  // namespace hamiltone::app

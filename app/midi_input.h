@@ -1,0 +1,54 @@
+// MIDI input on RtMidi 5: a real port or a virtual one the player creates. Each channel message is
+// timestamped on arrival and copied into a lock-free queue that the audio thread drains; sysex,
+// clock and active sensing are ignored (RtMidi drops them before they reach us).
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "midi/midi_message.h"
+#include "synth/spsc_queue.h"
+
+namespace hamiltone::app {
+
+struct MidiError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// A message and its arrival on the steady clock, in nanoseconds.
+struct StampedMessage {
+  std::int64_t arrivalNs = 0;
+  MidiMessage message;
+};
+
+std::int64_t steadyNanoseconds();
+
+class MidiInput {
+ public:
+  static constexpr size_t kQueueSize = 4096;
+
+  // api: "jack" or "alsa" (PulseAudio has no MIDI: it uses ALSA's sequencer). Throws MidiError.
+  explicit MidiInput(const std::string& api);
+  ~MidiInput();
+  std::vector<std::string> ports();
+  void openPort(int port);  // throws MidiError listing the ports
+  void openVirtualPort(const std::string& name);
+  void close();
+
+  SpscQueue<StampedMessage>& queue() { return queue_; }
+  long dropped() const { return dropped_.load(); }  // the queue was full
+
+ private:
+  static void arrived(double, std::vector<unsigned char>* bytes, void* self);
+
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  SpscQueue<StampedMessage> queue_{kQueueSize};
+  std::atomic<long> dropped_{0};
+};
+
+}  // namespace hamiltone::app

@@ -1,0 +1,222 @@
+// hamiltone-play: plays presets live from a MIDI keyboard (or a virtual MIDI port) through the
+// sound card or a JACK server, optionally recording exactly what it plays.
+#include <unistd.h>
+
+#include <CLI/App.hpp>
+#include <CLI/Config.hpp>
+#include <CLI/Formatter.hpp>
+#include <CLI/Validators.hpp>
+#include <csignal>
+#include <cstdio>
+#include <ctime>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "audio_output.h"
+#include "midi_input.h"
+#include "number_arguments.h"
+#include "player.h"
+#include "presets/preset_loader.h"
+#include "recorder.h"
+#include "usage_error.h"
+
+namespace hamiltone::app {
+namespace {
+
+struct PlayArguments {
+  std::vector<std::string> presets;
+  std::string api = "jack", device, sampleRate = "48000", buffer = "128", midiPort, virtualMidi;
+  std::string record, voices;
+  bool listDevices = false, quiet = false;
+};
+
+constexpr int kExitUsage = cli::kExitUsage;
+
+std::string describe(std::uint32_t m) {
+  if (m == 0) return "-";
+  const int status = static_cast<int>(m >> 16), d1 = (m >> 8) & 0x7F, d2 = m & 0x7F;
+  char text[48];
+  switch (status & 0xF0) {
+    case 0x90:
+      std::snprintf(text, sizeof text, "on %d/%d", d1, d2);
+      break;
+    case 0x80:
+      std::snprintf(text, sizeof text, "off %d", d1);
+      break;
+    case 0xB0:
+      std::snprintf(text, sizeof text, "cc%d=%d", d1, d2);
+      break;
+    case 0xC0:
+      std::snprintf(text, sizeof text, "program %d", d1);
+      break;
+    case 0xE0:
+      std::snprintf(text, sizeof text, "bend %d", (d2 << 7 | d1) - 8192);
+      break;
+    default:
+      std::snprintf(text, sizeof text, "%02X %d %d", status, d1, d2);
+  }
+  return text;
+}
+
+int listDevices(const std::string& api) {
+  std::printf("audio APIs in this build:");
+  for (const std::string& a : AudioOutput::compiledApis()) std::printf(" %s", a.c_str());
+  std::printf("\n");
+  AudioOutput audio(api);
+  std::printf("%s output devices:\n", api.c_str());
+  for (const AudioDevice& d : audio.devices())
+    std::printf("  %d: %s (%d channels)%s\n", d.id, d.name.c_str(), d.outputChannels,
+                d.isDefault ? " default" : "");
+  MidiInput midi(api);
+  std::printf("%s MIDI input ports:\n", api == "pulse" ? "alsa" : api.c_str());
+  const std::vector<std::string> ports = midi.ports();
+  for (size_t i = 0; i < ports.size(); ++i) std::printf("  %zu: %s\n", i, ports[i].c_str());
+  return 0;
+}
+
+int play(const PlayArguments& a) {
+  if (a.listDevices) return listDevices(a.api);
+  if (!a.midiPort.empty() && !a.virtualMidi.empty())
+    throw cli::UsageError("give at most one of --midi-port N and --virtual-midi NAME");
+  const int rate = static_cast<int>(cli::parseInteger("--sample-rate", a.sampleRate, 8000, 384000));
+  unsigned buffer = static_cast<unsigned>(cli::parseInteger("--buffer", a.buffer, 16, 8192));
+  const int device =
+      a.device.empty() ? -1 : static_cast<int>(cli::parseInteger("--device", a.device, 0));
+  const int voices =
+      a.voices.empty() ? 0 : static_cast<int>(cli::parseInteger("--voices", a.voices, 1, 128));
+
+  // SIGINT and SIGTERM are taken by this thread alone (sigtimedwait below); every thread started
+  // from here on — audio, MIDI, the recorder — inherits the mask.
+  sigset_t stopSignals;
+  sigemptyset(&stopSignals);
+  sigaddset(&stopSignals, SIGINT);
+  sigaddset(&stopSignals, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &stopSignals, nullptr);
+
+  // Presets load and their voices are built here, off the audio thread; program change then only
+  // switches between instruments that are ready.
+  std::vector<Instrument> instruments;
+  std::string errors;
+  const std::vector<std::string> files =
+      a.presets.empty() ? std::vector<std::string>{HAMILTONE_DEFAULT_PRESET} : a.presets;
+  for (const std::string& file : files) {
+    try {
+      instruments.push_back(loadPreset(file));
+    } catch (const PresetError& e) {
+      errors += std::string(errors.empty() ? "" : "\n") + e.what();
+    }
+  }
+  if (!errors.empty()) throw cli::UsageError("bad preset:\n" + errors);
+
+  AudioOutput audio(a.api);  // AudioError: exit 2 with what exists
+  const int output = audio.resolve(device);
+  MidiInput midi(a.api);
+  Synth synth;
+  try {
+    synth.prepare(std::move(instruments),
+                  {.sampleRate = static_cast<double>(rate), .maxBlock = 8192, .notes = {}});
+  } catch (const std::invalid_argument& e) {
+    throw cli::UsageError(std::string("preset does not build at this sample rate: ") + e.what());
+  }
+  synth.setPolyphony(voices);
+  std::unique_ptr<Recorder> recorder;
+  if (!a.record.empty()) recorder = std::make_unique<Recorder>(a.record, rate);
+  Player player(synth, midi.queue(), recorder ? &recorder->ring() : nullptr, rate, 8192);
+
+  audio.open(output, static_cast<unsigned>(rate), buffer, [&player](float* out, int frames, bool) {
+    player.render(out, frames, steadyNanoseconds());
+  });
+  if (!a.virtualMidi.empty())
+    midi.openVirtualPort(a.virtualMidi);
+  else if (!a.midiPort.empty())
+    midi.openPort(static_cast<int>(cli::parseInteger("--midi-port", a.midiPort, 0)));
+  if (recorder) recorder->start();
+  audio.start();
+
+  const bool status = !a.quiet && ::isatty(2);
+  if (!a.quiet)
+    std::fprintf(stderr, "hamiltone-play: %s, %d Hz, %u frames (%.1f ms); Ctrl-C stops\n",
+                 a.api.c_str(), rate, buffer, 1000.0 * buffer / rate);
+  timespec wait{0, 250'000'000};
+  int signal = -1;
+  while (signal < 0) {
+    signal = sigtimedwait(&stopSignals, nullptr, &wait);
+    if (!status) continue;
+    const Player::Status s = player.status();
+    std::fprintf(stderr,
+                 "\r  voices %2d/%-3d  cpu %3.0f%% (peak %3.0f%%)  underruns %ld  midi %-12s  "
+                 "guard %d   ",
+                 s.voices, s.limit, 100.0 * s.load, 100.0 * s.peakLoad, audio.underruns(),
+                 describe(s.lastMessage).c_str(), s.guardEvents);
+    std::fflush(stderr);
+  }
+  audio.stop();
+  midi.close();
+  const Player::Status s = player.status();
+  if (status) std::fprintf(stderr, "\n");
+  std::fprintf(stderr,
+               "hamiltone-play: stopped by %s; underruns %ld; peak cpu %.0f%%; guard events %d\n",
+               signal == SIGINT ? "SIGINT" : "SIGTERM", audio.underruns(), 100.0 * s.peakLoad,
+               s.guardEvents);
+  if (recorder) {
+    const double seconds = recorder->finish();
+    std::fprintf(stderr, "hamiltone-play: recorded %.2f s to %s%s\n", seconds, a.record.c_str(),
+                 s.recordDropped ? " (with gaps: the disk fell behind)" : "");
+  }
+  return 0;
+}
+
+}  // namespace
+}  // namespace hamiltone::app
+
+int main(int argc, char** argv) {
+  using namespace hamiltone::app;
+  namespace cli = hamiltone::cli;
+  CLI::App app{"hamiltone-play: plays Hamiltone's physical models live from MIDI."};
+  PlayArguments a;
+  app.add_option("--preset", a.presets,
+                 "instrument preset (TOML); repeat it to load several, chosen by MIDI program "
+                 "change (0 = the first). Default: " HAMILTONE_DEFAULT_PRESET)
+      ->type_name("FILE");
+  app.add_option("--api", a.api, "audio (and MIDI) API")
+      ->check(CLI::IsMember({"jack", "alsa", "pulse"}))
+      ->capture_default_str();
+  cli::addNumberOption(&app, "--device", a.device, "N", "output device (see --list-devices)");
+  cli::addNumberOption(&app, "--sample-rate", a.sampleRate, "HZ", "sample rate");
+  cli::addNumberOption(&app, "--buffer", a.buffer, "FRAMES", "buffer size asked of the device");
+  cli::addNumberOption(&app, "--midi-port", a.midiPort, "N",
+                       "MIDI input port (see --list-devices)");
+  app.add_option("--virtual-midi", a.virtualMidi, "create a MIDI input port with this name")
+      ->type_name("NAME");
+  app.add_option("--record", a.record, "also write what is played to this WAV file (24-bit)")
+      ->type_name("FILE");
+  cli::addNumberOption(&app, "--voices", a.voices, "N",
+                       "polyphony, 1 … 128 (default: the preset's)");
+  app.add_flag("--list-devices", a.listDevices, "list the APIs, output devices and MIDI ports");
+  app.add_flag("--quiet", a.quiet, "no status line");
+  app.footer(
+      "Exit codes: 0 stopped by SIGINT/SIGTERM (the recording is complete), 1 an I/O error, "
+      "2 bad input or no usable audio API/device.");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "hamiltone-play: %s (see hamiltone-play --help)\n", e.what());
+    return kExitUsage;
+  }
+  try {
+    return play(a);
+  } catch (const hamiltone::cli::UsageError& e) {
+    std::fprintf(stderr, "hamiltone-play: %s\n", e.what());
+  } catch (const AudioError& e) {
+    std::fprintf(stderr, "hamiltone-play: %s\n", e.what());
+  } catch (const MidiError& e) {
+    std::fprintf(stderr, "hamiltone-play: %s\n", e.what());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "hamiltone-play: error: %s\n", e.what());
+    return 1;
+  }
+  return kExitUsage;
+}

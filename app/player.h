@@ -1,0 +1,62 @@
+// The audio callback's work, apart from any audio API (so it can be tested and sanitised alone):
+// MIDI from the queue placed on the block's samples, the synthesizer, the recording tee, the load
+// measurement and the overload protection. Real-time safe: no allocation, lock, I/O or syscall
+// beyond reading the steady clock.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+
+#include "midi_input.h"
+#include "synth/spsc_queue.h"
+#include "synth/synth.h"
+
+#if defined(__clang__) && __clang_major__ >= 20
+#define HAMILTONE_NONBLOCKING [[clang::nonblocking]]
+#else
+#define HAMILTONE_NONBLOCKING
+#endif
+
+namespace hamiltone::app {
+
+class Player {
+ public:
+  static constexpr int kMaxEventsPerBlock = 1024;  // more wait for the next block
+  static constexpr double kOverload = 0.8;         // of the buffer period: drop a voice
+  static constexpr double kRelief = 0.5;           // below this for 1 s: allow one more
+
+  // `record` may be null. The synth must be prepared for blocks of at least `maxFrames`.
+  Player(Synth& synth, SpscQueue<StampedMessage>& midi, SpscQueue<float>* record, double sampleRate,
+         int maxFrames);
+
+  // Fills `frames` interleaved stereo frames. A message that arrived a time d before `nowNs`
+  // lands d·rate samples before the end of this block: a constant latency of one buffer, and
+  // the spacing of the messages kept to the sample.
+  void render(float* interleaved, int frames, std::int64_t nowNs) noexcept HAMILTONE_NONBLOCKING;
+
+  struct Status {
+    int voices = 0, limit = 0, guardEvents = 0;
+    double load = 0.0, peakLoad = 0.0;  // compute time / buffer period
+    long recordDropped = 0;             // samples the recording ring had no room for
+    std::uint32_t lastMessage = 0;      // status << 16 | data1 << 8 | data2; 0 before any
+  };
+  Status status() const;  // from any thread
+
+ private:
+  void protect(double load, double blockSeconds) noexcept;
+
+  Synth& synth_;
+  SpscQueue<StampedMessage>& midi_;
+  SpscQueue<float>* record_;
+  double sampleRate_;
+  std::vector<float> left_, right_;
+  std::vector<SynthEvent> events_;
+  int fullLimit_ = 0, limit_ = 0;
+  double reliefTime_ = 0.0;
+  std::atomic<int> voices_{0}, limitShown_{0}, guard_{0};
+  std::atomic<double> load_{0.0}, peak_{0.0};
+  std::atomic<long> recordDropped_{0};
+  std::atomic<std::uint32_t> last_{0};
+};
+
+}  // namespace hamiltone::app

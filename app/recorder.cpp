@@ -1,0 +1,49 @@
+// The recorder's writer thread: it empties the ring every 10 ms into the WAV writer.
+#include "recorder.h"
+
+#include <chrono>
+#include <vector>
+
+namespace hamiltone::app {
+
+Recorder::Recorder(const std::string& path, int sampleRate)
+    : wav_(path, "--record", sampleRate, 2, cli::SampleFormat::pcm24),
+      ring_(static_cast<size_t>(kRingSeconds * sampleRate * 2)),
+      sampleRate_(sampleRate) {}
+
+Recorder::~Recorder() {
+  if (!finished_ && writer_.joinable()) {
+    stopping_ = true;
+    writer_.join();
+  }
+}
+
+void Recorder::start() {
+  writer_ = std::thread([this] {
+    while (!stopping_.load()) {
+      drain();
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    drain();
+  });
+}
+
+void Recorder::drain() {
+  std::vector<float> chunk(8192);
+  size_t n;
+  while ((n = ring_.pop(chunk.data(), chunk.size())) > 0) {
+    wav_.write(chunk.data(), n / 2);  // frames: the audio thread pushes whole frames
+    frames_ += static_cast<long>(n / 2);
+  }
+}
+
+double Recorder::finish() {
+  if (finished_) return static_cast<double>(frames_) / sampleRate_;
+  stopping_ = true;
+  if (writer_.joinable()) writer_.join();
+  wav_.commit();
+  finished_ = true;
+  return static_cast<double>(frames_) / sampleRate_;
+}
+
+}  // namespace hamiltone::app
