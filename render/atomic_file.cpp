@@ -34,6 +34,7 @@ void setPending(const std::string& path) {
   std::signal(SIGINT, removeTemporaryAndExit);
   std::signal(SIGTERM, removeTemporaryAndExit);
   std::signal(SIGHUP, removeTemporaryAndExit);
+  std::signal(SIGXFSZ, removeTemporaryAndExit);  // past the file-size limit (ulimit -f)
 }
 
 void clearPending() { pendingTemporary[0] = '\0'; }

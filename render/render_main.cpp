@@ -16,6 +16,7 @@
 #include "presets/preset_loader.h"
 #include "progress_bar.h"
 #include "usage_error.h"
+#include "util/format_number.h"
 
 namespace hamiltone::cli {
 namespace {
@@ -26,6 +27,9 @@ struct RenderArguments {
   std::string sampleRate = "48000", tail = "3", voices, block = "256";
   bool quiet = false, listParams = false;
 };
+
+constexpr double kMaxRenderSeconds = 24.0 * 3600.0;
+constexpr double kMaxWavBytes = 4294967295.0 - 1024.0;  // RIFF's 32-bit sizes, less the header
 
 SampleFormat sampleFormat(const std::string& name) {
   if (name == "pcm16") return SampleFormat::pcm16;
@@ -41,11 +45,13 @@ int run(const RenderArguments& a) {
   if (a.midi.empty() == a.notes.empty())
     throw UsageError("give exactly one of --midi FILE or --notes LIST");
   if (a.out.empty()) throw UsageError("-o FILE: the WAV file to write is required");
-  const double rate = static_cast<double>(parseInteger("--sample-rate", a.sampleRate, 8000, 384000));
+  const double rate =
+      static_cast<double>(parseInteger("--sample-rate", a.sampleRate, 8000, 384000));
   const double tail = parseReal("--tail", a.tail, Range::nonNegative, " seconds");
   if (tail > 600.0) throw UsageError("--tail = " + a.tail + ": at most 600 seconds");
   const int block = static_cast<int>(parseInteger("--block", a.block, 1, 8192));
-  const int voices = a.voices.empty() ? 0 : static_cast<int>(parseInteger("--voices", a.voices, 1, 128));
+  const int voices =
+      a.voices.empty() ? 0 : static_cast<int>(parseInteger("--voices", a.voices, 1, 128));
 
   // Everything is read and checked before the output file is created.
   std::vector<Instrument> instruments;
@@ -79,9 +85,29 @@ int run(const RenderArguments& a) {
     messages = std::move(list.messages);
     end = list.endSeconds;
   }
+  if (!(end + tail <= kMaxRenderSeconds))
+    throw UsageError((a.midi.empty() ? "--notes" : "--midi " + a.midi) + ": lasts " +
+                     formatNumber(end) + " s: at most 24 h can be rendered");
+  const double bytesPerSample = a.format == "pcm16" ? 2.0 : a.format == "pcm24" ? 3.0 : 4.0;
+  if ((end + tail) * rate * 2.0 * bytesPerSample > kMaxWavBytes)
+    throw UsageError("the render would be " + formatNumber(end + tail) + " s at " + a.sampleRate +
+                     " Hz in " + a.format +
+                     ": more than the 4 GiB a WAV file can hold; use a lower rate or pcm16");
   std::vector<bool> notes(128, false);
   for (const TimedMessage& m : messages)
     if (m.message.kind() == midi::noteOn) notes[m.message.data1 & 0x7F] = true;
+  std::string outside;
+  for (int note = 0; note < 128; ++note) {
+    bool playable = false;
+    for (const Instrument& i : instruments)
+      playable = playable || (note >= i.lowestNote && note <= i.highestNote);
+    if (notes[note] && !playable) outside += " " + std::to_string(note);
+  }
+  if (!outside.empty() && !a.quiet)
+    std::fprintf(stderr,
+                 "hamiltone-render: warning: no preset plays MIDI note(s)%s; they are "
+                 "silent\n",
+                 outside.c_str());
 
   Synth synth;
   try {
@@ -95,9 +121,8 @@ int run(const RenderArguments& a) {
   WavWriter out(a.out, "-o", static_cast<int>(rate), 2, sampleFormat(a.format));
   const double seconds = end + tail;
   ProgressBar bar(seconds, progressWanted(a.quiet));
-  const RenderStats stats =
-      renderPerformance(synth, messages, seconds, block, rate, out,
-                        [&](double done) { bar.update(done); });
+  const RenderStats stats = renderPerformance(synth, messages, seconds, block, rate, out,
+                                              [&](double done) { bar.update(done); });
   bar.finish();
   out.commit();
   if (!a.quiet) {
@@ -138,8 +163,7 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"pcm16", "pcm24", "float32"}))
       ->capture_default_str();
   addNumberOption(&app, "--tail", a.tail, "SECONDS", "rendered after the last event, 0 … 600");
-  addNumberOption(&app, "--voices", a.voices, "N",
-                  "polyphony, 1 … 128 (default: the preset's)");
+  addNumberOption(&app, "--voices", a.voices, "N", "polyphony, 1 … 128 (default: the preset's)");
   addNumberOption(&app, "--block", a.block, "FRAMES", "processing block, 1 … 8192");
   app.add_flag("--quiet", a.quiet, "no progress bar and no summary");
   app.add_flag("--list-params", a.listParams,

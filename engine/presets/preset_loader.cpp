@@ -905,9 +905,13 @@ void Loader::checkVoices(const Instrument& instrument) {
   }
   for (int note = lo; note <= hi; note += 12) notes.insert(note);
   for (const Anchor& a : anchors_) notes.insert(a.note);
+  // The patches the synthesizer plays: the outermost unison strings carry the detune extremes.
   for (int note : notes) try {
-      StringVoice voice;
-      voice.prepare(instrument.keys[note - lo].patch, note, kCheckRate);
+      const int unisons = instrument.keys[note - lo].unisons;
+      for (int string : {0, unisons - 1}) {
+        StringVoice voice;
+        voice.prepare(unisonPatch(instrument, note, string), note, kCheckRate);
+      }
     } catch (const std::exception& e) {
       voiceError(e.what(), note);
     }

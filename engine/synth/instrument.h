@@ -32,4 +32,10 @@ struct Instrument {
   double panSpread = 0.5;                  // 0: all centred; 1: lowest key left … highest right
 };
 
+// The patch of unison string `string` (0 … unisons−1) of `note`, as the synthesizer plays it: the
+// strings spread evenly across ±detune/2 (one at 0; two at ±d/2; three at −d/2, 0, +d/2), each
+// with the instrument's bend range, and sharing one hammer — M_H/n and K_H/n each, the same hammer
+// while the strings move alike (F = K δ^p). The loader checks these very patches.
+StringPatch unisonPatch(const Instrument& instrument, int note, int string);
+
 }  // namespace hamiltone

@@ -12,21 +12,9 @@ void KeyVoice::prepare(const Instrument& instrument, int note, double sampleRate
   std::vector<StringVoice> strings;
   std::unique_ptr<PlateVoice> plate;
   if (instrument.model == InstrumentModel::string) {
-    const StringKey& key = instrument.keys.at(note - instrument.lowestNote);
-    strings.resize(key.unisons);
-    for (int s = 0; s < key.unisons; ++s) {
-      // Spread evenly across ±detune/2: one string at 0, two at ±d/2, three at −d/2, 0, +d/2.
-      const double cents =
-          key.unisons == 1 ? 0.0 : key.detuneCents * (s / (key.unisons - 1.0) - 0.5);
-      StringPatch patch = key.patch;
-      patch.a4Hz *= std::pow(2.0, cents / 1200.0);
-      // One hammer strikes all the unisons: each string gets a share of its mass and felt
-      // stiffness, which is the same hammer exactly while the strings move alike (F = K δ^p).
-      patch.hammer.mass /= key.unisons;
-      patch.hammer.stiffness /= key.unisons;
-      patch.bendRange = instrument.bendRange;
-      strings[s].prepare(patch, note, sampleRate);
-    }
+    strings.resize(instrument.keys.at(note - instrument.lowestNote).unisons);
+    for (size_t s = 0; s < strings.size(); ++s)
+      strings[s].prepare(unisonPatch(instrument, note, static_cast<int>(s)), note, sampleRate);
   } else {
     plate = std::make_unique<PlateVoice>();
     plate->prepare(instrument.plate, note, sampleRate);
@@ -43,31 +31,45 @@ void KeyVoice::prepare(const Instrument& instrument, int note, double sampleRate
   for (auto* buffer : {&voiceLeft_, &voiceRight_, &mixLeft_, &mixRight_})
     buffer->assign(maxBlock, 0.0f);
   fadeSamples_ = std::max(1, static_cast<int>(std::lround(kFadeS * sampleRate)));
+  envelopeDecay_ = std::exp(-1.0 / (kEnvelopeS * sampleRate));
+  attackSamples_ = std::lround(kEnvelopeS * sampleRate);
+  sinceStrike_ = attackSamples_;
   fadeLeft_ = 0;
   pendingVelocity_ = -1.0;
+  releasePending_ = false;
+  envelope_ = 0.0;
   down = sustained = false;
 }
 
 void KeyVoice::strike(double velocity, long order) noexcept {
-  for (StringVoice& s : strings_) s.noteOn(velocity);
-  if (plate_) plate_->noteOn(velocity);
   order_ = order;
+  sinceStrike_ = 0;
+  if (fading() || pending()) {
+    pendingVelocity_ = velocity;
+    releasePending_ = false;
+    return;
+  }
+  strikeNow(velocity);
 }
 
-void KeyVoice::strikeAfterFade(double velocity, long order) noexcept {
-  pendingVelocity_ = velocity;
-  pendingOrder_ = order;
+void KeyVoice::strikeNow(double velocity) noexcept {
+  for (StringVoice& s : strings_) s.noteOn(velocity);
+  if (plate_) plate_->noteOn(velocity);
 }
 
 void KeyVoice::release() noexcept {
+  if (pending()) {
+    releasePending_ = true;
+    return;
+  }
   for (StringVoice& s : strings_) s.release();
   if (plate_) plate_->release();
-  pendingVelocity_ = -1.0;
 }
 
 void KeyVoice::fadeOut() noexcept {
   if (sounding() && !fading()) fadeLeft_ = fadeSamples_;
   pendingVelocity_ = -1.0;
+  releasePending_ = false;
   down = sustained = false;
 }
 
@@ -92,22 +94,24 @@ double KeyVoice::fundamentalHz() const {
 }
 
 void KeyVoice::process(std::span<float> left, std::span<float> right, double gain) noexcept {
-  lastPeak_ = 0.0;
   size_t done = 0;
   while (done < left.size()) {
+    if (!fading() && pending()) {  // the fade is over (or its voices fell silent): strike
+      strikeNow(pendingVelocity_);
+      pendingVelocity_ = -1.0;
+      if (releasePending_) release();
+      releasePending_ = false;
+    }
     const bool wasFading = fading();
     size_t length = left.size() - done;
     if (wasFading) length = std::min(length, static_cast<size_t>(fadeLeft_));
     render(left.subspan(done, length), right.subspan(done, length), gain);
     done += length;
-    if (!wasFading || fading()) continue;
-    // The fade is over: free the voices, and strike what waited for it from this sample on.
-    for (StringVoice& s : strings_) s.reset();
-    if (plate_) plate_->reset();
-    if (pendingVelocity_ < 0.0) return;
-    strike(pendingVelocity_, pendingOrder_);
-    pendingVelocity_ = -1.0;
-    down = true;
+    if (wasFading && !fading()) {  // free the voices; a pending strike starts next round
+      for (StringVoice& s : strings_) s.reset();
+      if (plate_) plate_->reset();
+      if (!pending()) break;
+    }
   }
 }
 
@@ -132,12 +136,11 @@ void KeyVoice::render(std::span<float> left, std::span<float> right, double gain
     plate_->process(voiceL, voiceR);
     add(true);
   }
-  float peak = 0.0f;
-  for (size_t i = 0; i < n; ++i) peak = std::max({peak, std::abs(mixL[i]), std::abs(mixR[i])});
-  lastPeak_ = std::max(lastPeak_, static_cast<double>(peak));
-
   const double gl = gain * panLeft_, gr = gain * panRight_;
+  sinceStrike_ += static_cast<long>(n);
   for (size_t i = 0; i < n; ++i) {
+    envelope_ = std::max({static_cast<double>(std::abs(mixL[i])),
+                          static_cast<double>(std::abs(mixR[i])), envelope_ * envelopeDecay_});
     // Linear to zero: the last faded sample is 0, and each step is at most peak / 240 at 48 kHz.
     const double fade = fadeLeft_ > 0 ? static_cast<double>(--fadeLeft_) / fadeSamples_ : 1.0;
     left[i] += static_cast<float>(gl * fade * mixL[i]);

@@ -2,6 +2,7 @@
 // image, and the key's state — held, sustained by the pedal, released, or fading out when stolen.
 #pragma once
 
+#include <cmath>
 #include <memory>
 #include <span>
 #include <vector>
@@ -12,25 +13,31 @@ namespace hamiltone {
 
 class KeyVoice {
  public:
-  static constexpr double kFadeS = 0.005;  // a stolen or silenced voice fades over 5 ms
+  static constexpr double kFadeS = 0.005;     // a stolen or silenced voice fades over 5 ms
+  static constexpr double kEnvelopeS = 0.05;  // the loudness follower's release time constant
 
   // May allocate; throws std::invalid_argument naming the patch field (from the voices).
   void prepare(const Instrument& instrument, int note, double sampleRate, int maxBlock);
 
-  void strike(double velocity, long order) noexcept;  // 0 … 1; re-strikes a sounding key
-  void release() noexcept;                            // the damper falls
-  void fadeOut() noexcept;                            // stolen: fades, then frees itself
-  // A note-on for a fading key waits for the fade to end, so the re-strike starts from rest.
-  void strikeAfterFade(double velocity, long order) noexcept;
+  // 0 … 1. A sounding key is struck again where it is; a fading one is struck once its fade
+  // ends, from rest (the note-on is pending until then).
+  void strike(double velocity, long order) noexcept;
+  void release() noexcept;  // the damper falls (on a pending strike: right after it)
+  void fadeOut() noexcept;  // stolen or silenced: fades over kFadeS, then frees itself
   void setBend(double semitones) noexcept;
 
   // Adds the key's next left.size() samples, times `gain`, into left and right. Never allocates.
   void process(std::span<float> left, std::span<float> right, double gain) noexcept;
 
-  bool sounding() const;
+  bool sounding() const;  // a voice of the key is active
   bool fading() const { return fadeLeft_ > 0; }
-  double lastPeak() const { return lastPeak_; }  // of the latest block, before gain
-  long order() const { return order_; }          // when it was struck: higher is newer
+  bool pending() const { return pendingVelocity_ >= 0.0; }
+  bool busy() const { return sounding() || fading() || pending(); }  // needs process()
+  // Loudness, for stealing: the peak of the output followed sample by sample with a 50 ms
+  // release (so the choice does not depend on the block size); infinite for 50 ms after a strike,
+  // so a key just struck — its hammer still on the way — is not taken for a quiet one.
+  double loudness() const { return sinceStrike_ < attackSamples_ ? INFINITY : envelope_; }
+  long order() const { return order_; }  // when it was struck: higher is newer
   int guardEvents() const;
   double fundamentalHz() const;
 
@@ -39,6 +46,7 @@ class KeyVoice {
 
  private:
   void render(std::span<float> left, std::span<float> right, double gain) noexcept;
+  void strikeNow(double velocity) noexcept;
 
   std::vector<StringVoice> strings_;  // the unisons (string model)
   std::unique_ptr<PlateVoice> plate_;
@@ -46,8 +54,10 @@ class KeyVoice {
   double panLeft_ = 1.0, panRight_ = 1.0;
   int fadeSamples_ = 1, fadeLeft_ = 0;
   double pendingVelocity_ = -1.0;  // < 0: none
-  long pendingOrder_ = 0, order_ = 0;
-  double lastPeak_ = 0.0;
+  bool releasePending_ = false;    // released before its pending strike
+  long order_ = 0;
+  double envelope_ = 0.0, envelopeDecay_ = 0.0;
+  long sinceStrike_ = 0, attackSamples_ = 0;
 };
 
 }  // namespace hamiltone

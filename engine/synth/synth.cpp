@@ -21,6 +21,11 @@ void Synth::prepare(std::vector<Instrument> instruments, const SynthSetup& setup
   std::vector<double> gains;
   for (size_t p = 0; p < instruments.size(); ++p) {
     const Instrument& instrument = instruments[p];
+    if (instrument.polyphony < 1 || instrument.lowestNote > instrument.highestNote)
+      throw std::invalid_argument(
+          instrument.source + ": polyphony " + std::to_string(instrument.polyphony) +
+          " and notes " + std::to_string(instrument.lowestNote) + " … " +
+          std::to_string(instrument.highestNote) + ": need at least one voice and one note");
     const int count = instrument.highestNote - instrument.lowestNote + 1;
     voices[p].resize(count);
     hasVoice[p].assign(count, false);
@@ -69,7 +74,8 @@ const KeyVoice* Synth::voice(int program, int note) const {
 
 void Synth::setPolyphony(int voices) noexcept {
   polyphonyOverride_ = std::max(voices, 0);
-  while (activeVoices() > polyphony()) stealOne();
+  while (activeVoices() > polyphony() && stealOne()) {
+  }
 }
 
 int Synth::polyphony() const {
@@ -79,7 +85,7 @@ int Synth::polyphony() const {
 int Synth::activeVoices() const {
   int count = 0;
   for (const auto& keys : voices_)
-    for (const KeyVoice& v : keys) count += v.sounding() && !v.fading();
+    for (const KeyVoice& v : keys) count += (v.sounding() && !v.fading()) || v.pending();
   return count;
 }
 
@@ -91,36 +97,37 @@ int Synth::guardEvents() const {
 }
 
 // Released keys first (neither held nor sustained), the oldest of them, as they have decayed
-// longest; else the quietest held key by the peak of its latest block, the oldest on a tie. It
-// fades out over 5 ms.
-void Synth::stealOne() noexcept {
+// longest; else the quietest held key (KeyVoice::loudness), the oldest on a tie. It fades out over
+// 5 ms. False when no key can be taken (all are fading already).
+bool Synth::stealOne() noexcept {
   KeyVoice* victim = nullptr;
   auto better = [&](const KeyVoice& v) {
     if (!victim) return true;
     const bool free = !v.down && !v.sustained, victimFree = !victim->down && !victim->sustained;
     if (free != victimFree) return free;
-    if (!free && v.lastPeak() != victim->lastPeak()) return v.lastPeak() < victim->lastPeak();
+    if (!free && v.loudness() != victim->loudness()) return v.loudness() < victim->loudness();
     return v.order() < victim->order();
   };
   for (auto& keys : voices_)
     for (KeyVoice& v : keys)
-      if (v.sounding() && !v.fading() && better(v)) victim = &v;
-  if (victim) victim->fadeOut();
+      if (v.sounding() && !v.fading() && !v.pending() && better(v)) victim = &v;
+  if (!victim) return false;
+  victim->fadeOut();
+  return true;
 }
 
 void Synth::noteOn(int note, int velocity) noexcept {
   KeyVoice* voice = keyVoice(program_, note);
   if (!voice) return;
-  const double v = velocity / 127.0;
-  if (voice->fading()) {
-    voice->strikeAfterFade(v, ++strikes_);
-  } else {
-    if (!voice->sounding())
-      while (activeVoices() >= polyphony()) stealOne();
-    voice->setBend(bend_ * instruments_[program_].bendRange);
-    voice->strike(v, ++strikes_);
-    voice->down = true;
-  }
+  // The key held in another instrument (before a program change) is let go first.
+  if (downProgram_[note] >= 0 && downProgram_[note] != program_) noteOff(note);
+  const bool counted = (voice->sounding() && !voice->fading()) || voice->pending();
+  if (!counted)
+    while (activeVoices() >= polyphony() && stealOne()) {
+    }
+  voice->setBend(bend_ * instruments_[program_].bendRange);
+  voice->strike(velocity / 127.0, ++strikes_);
+  voice->down = true;
   voice->sustained = false;
   downProgram_[note] = program_;
 }
@@ -211,7 +218,7 @@ void Synth::handle(const MidiMessage& m) noexcept {
 void Synth::render(std::span<float> left, std::span<float> right) noexcept {
   for (size_t p = 0; p < voices_.size(); ++p)
     for (KeyVoice& v : voices_[p])
-      if (v.sounding()) v.process(left, right, gains_[p]);
+      if (v.busy()) v.process(left, right, gains_[p]);
 }
 
 void Synth::process(std::span<float> left, std::span<float> right,

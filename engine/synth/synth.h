@@ -42,7 +42,7 @@ class Synth {
   void prepare(std::vector<Instrument> instruments, const SynthSetup& setup);
 
   // Writes left.size() frames (right must be as long). `events` sorted by offset, each offset in
-  // [0, left.size()); an event out of order or range is applied at the nearest valid sample.
+  // [0, left.size()); an event out of order is applied at once, one past the block after it.
   void process(std::span<float> left, std::span<float> right,
                std::span<const SynthEvent> events) noexcept;
   void handle(const MidiMessage& message) noexcept;  // now, between two samples
@@ -67,7 +67,7 @@ class Synth {
   void setBend(double fraction) noexcept;
   void allSoundOff() noexcept;
   KeyVoice* keyVoice(int program, int note);
-  void stealOne() noexcept;
+  bool stealOne() noexcept;
 
   std::vector<Instrument> instruments_;
   std::vector<std::vector<KeyVoice>> voices_;  // [instrument][note − lowest]

@@ -137,6 +137,7 @@ void PlateVoice::prepare(const PlatePatch& patch, int midiNote, double sampleRat
   strikeIndex_ = std::move(index);
   strikeWeight_ = std::move(weight);
   for (int c = 0; c < 2; ++c) decimators_[c] = std::move(decimators[c]);
+  quiet_.prepare(sampleRate);
   reset();
 }
 
@@ -232,9 +233,7 @@ void PlateVoice::process(std::span<float> left, std::span<float> right) noexcept
     reset();
     return;
   }
-  if (quiet_.update(released_, blockPeak(left, right, rightCount),
-                    static_cast<double>(left.size()) / sampleRate_, left, right, rightCount))
-    active_ = false;
+  if (quiet_.update(released_, left, right, rightCount)) active_ = false;
 }
 
 }  // namespace hamiltone

@@ -88,7 +88,10 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
   // Everything is built in locals and committed only once nothing more can throw, so a failed
   // prepare() leaves the voice as it was.
   const double k = 1.0 / (sampleRate * r);
-  const double target = equalTemperament(midiNote, patch.a4Hz);
+  require(std::isfinite(patch.detuneCents) && std::abs(patch.detuneCents) <= 50.0, "detune_cents",
+          patch.detuneCents, "between −50 and 50 cents");
+  const double target =
+      equalTemperament(midiNote, patch.a4Hz) * std::pow(2.0, patch.detuneCents / 1200.0);
   // The loss sets the grid (its σ1 tightens (44)) and the tuning sets the loss (ξ depends on T0):
   // two rounds settle both, σ1 being a small correction. The grid leaves room for the bend's
   // largest tension β: h_min grows at most as sqrt(β) (minimalSpacing), so a coarser factor covers
@@ -135,6 +138,7 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
   scheme_ = std::move(scheme);
   atRest_ = std::move(atRest);
   for (int c = 0; c < 2; ++c) decimators_[c] = std::move(decimators[c]);
+  quiet_.prepare(sampleRate);
   reset();
 }
 
@@ -272,9 +276,7 @@ void StringVoice::process(std::span<float> left, std::span<float> right) noexcep
     reset();
     return;
   }
-  if (quiet_.update(released_, blockPeak(left, right, rightCount),
-                    static_cast<double>(left.size()) / sampleRate_, left, right, rightCount))
-    active_ = false;
+  if (quiet_.update(released_, left, right, rightCount)) active_ = false;
 }
 
 }  // namespace hamiltone

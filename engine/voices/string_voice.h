@@ -20,6 +20,7 @@ struct StringPatch {
   HammerFelt hammer;
   TuneBy tuneBy = TuneBy::tension;
   double a4Hz = 440.0;
+  double detuneCents = 0.0;  // from the note's equal-tempered pitch (a unison string's offset)
   GridRule grid = GridRule::transverse;
   double gridFactor = 1.0;
   int oversampling = 1;  // 1, 2, 4, 8 or 16

@@ -39,7 +39,8 @@ Played play(Voice& voice, double velocity) {
   return out;
 }
 
-// One voice per key: the unison strings differ from it by a few cents only.
+// One voice per key, the first unison string as the synthesizer plays it (the strings differ by a
+// few cents only).
 Played playNote(const Instrument& instrument, int note, double velocity) {
   if (instrument.model == InstrumentModel::plate) {
     PlateVoice voice;
@@ -47,7 +48,7 @@ Played playNote(const Instrument& instrument, int note, double velocity) {
     return play(voice, velocity);
   }
   StringVoice voice;
-  voice.prepare(instrument.keys[note - instrument.lowestNote].patch, note, kRate);
+  voice.prepare(unisonPatch(instrument, note, 0), note, kRate);
   return play(voice, velocity);
 }
 
@@ -57,12 +58,17 @@ TEST(BundledPresets, RenderClean) {
     const Instrument instrument =
         loadPreset(std::string(HAMILTONE_SOURCE_DIR) + "/presets/" + name + ".toml");
     const int lo = instrument.lowestNote, hi = instrument.highestNote;
+    // Strings: every key, softest and hardest, and mezzo-forte every 6th; plates (slow to
+    // prepare, their size a smooth function of the note): the lowest, middle and highest notes.
     std::set<int> notes{lo, (lo + hi) / 2, hi};
     if (instrument.model == InstrumentModel::string)
-      for (int note = lo; note <= hi; note += 6) notes.insert(note);
+      for (int note = lo; note <= hi; ++note) notes.insert(note);
     const double gain = std::pow(10.0, instrument.gainDb / 20.0);
     for (int note : notes)
       for (double velocity : {1.0 / 127.0, 64.0 / 127.0, 1.0}) {
+        if (velocity == 64.0 / 127.0 && instrument.model == InstrumentModel::string &&
+            (note - lo) % 6 != 0)
+          continue;
         const Played p = playNote(instrument, note, velocity);
         EXPECT_TRUE(p.finite) << name << " note " << note << " velocity " << velocity;
         EXPECT_EQ(p.guardEvents, 0) << name << " note " << note << " velocity " << velocity;

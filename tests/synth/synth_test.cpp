@@ -145,15 +145,22 @@ TEST(Synth, OutputIsBitIdenticalForTheSameInput) {
   EXPECT_EQ(x.right, y.right);
 }
 
-// Blocks of 1, 64 and 1000 frames: events land on the same samples and every voice runs sample by
-// sample, so the takes agree to float roundoff.
+// Blocks of 1, 64 and 1000 frames: events land on the same samples, every voice runs sample by
+// sample, stealing follows a per-sample loudness and voices free themselves sample by sample, so
+// the takes agree to float roundoff. The score steals (polyphony 2), releases, re-strikes a
+// fading key and lets released keys fall silent and free themselves.
 TEST(Synth, OutputDoesNotDependOnTheBlockSize) {
   const std::vector<TimedMessage> score = {
-      {0.0, on(48)}, {0.0123, on(52, 30)}, {0.05, off(48)}, {0.07, {0xE0, 0, 90}}, {0.09, on(48)}};
+      {0.0, on(48)},  {0.0123, on(52, 30)}, {0.05, off(48)}, {0.07, {0xE0, 0, 90}},
+      {0.09, on(55)}, {0.0905, on(48, 70)}, {0.12, off(52)}, {0.15, off(55)},
+      {0.2, off(48)}, {0.25, on(50, 127)},  {0.26, off(50)}};
   std::vector<Take> takes;
   for (int block : {1, 64, 1000}) {
-    Synth synth = prepared({pianoKeys(48, 55)}, 1000);
-    takes.push_back(render(synth, score, 0.15, block));
+    Instrument piano = pianoKeys(48, 55, 2);
+    for (StringKey& key : piano.keys) key.patch.damperT60 = 0.05;  // they free within the take
+    Synth synth = prepared({piano}, 1000);
+    takes.push_back(render(synth, score, 1.2, block));
+    EXPECT_EQ(synth.activeVoices(), 0) << "block " << block;
   }
   const float level = peak(takes[0].left);
   ASSERT_GT(level, 1e-3f);
@@ -163,6 +170,50 @@ TEST(Synth, OutputDoesNotDependOnTheBlockSize) {
           << "block take " << t << " at " << i;
       ASSERT_NEAR(takes[t].right[i], takes[0].right[i], 1e-6f * level);
     }
+}
+
+// The edge cases of a key's state: a note-on and note-off inside a steal's fade, a key stolen in
+// the last milliseconds of its own release, CC120 then the same key again, a program change
+// between a note-on and its note-off, and the sustain pedal over a re-strike.
+TEST(Synth, KeysNeverGetStuckOrDead) {
+  Instrument piano = pianoKeys(48, 52, 1);
+  Synth synth = prepared({piano, pianoKeys(48, 52, 4)});
+  // Polyphony 1: 50 steals 48; 48 again within the 5 ms fade, released within it too.
+  render(synth, {{0.0, on(48)}, {0.1, on(50)}, {0.101, on(48)}, {0.102, off(48)}}, 0.15, 64);
+  render(synth, {}, 1.0, 64);
+  EXPECT_FALSE(synth.voice(0, 48)->down);
+  EXPECT_LE(synth.activeVoices(), 1);
+  // CC120 with a voice about to free itself, then the key again: it sounds.
+  render(synth, {{0.0, cc(120, 0)}}, 0.05, 64);
+  Take take = render(synth, {{0.0, on(48, 127)}}, 0.2, 64);
+  EXPECT_TRUE(synth.voice(0, 48)->sounding());
+  EXPECT_GT(peak(take.left), 1e-2f);
+  // Program change between note-on and note-off: the note-off reaches the key that was struck;
+  // the same key struck in the new program lets the old one go.
+  render(synth, {{0.0, {0xC0, 1, 0}}, {0.0, on(50)}, {0.01, {0xC0, 0, 0}}, {0.02, off(50)}}, 0.05,
+         64);
+  EXPECT_FALSE(synth.voice(1, 50)->down);
+  render(synth, {{0.0, on(52)}, {0.01, {0xC0, 1, 0}}, {0.02, on(52)}}, 0.05, 64);
+  EXPECT_FALSE(synth.voice(0, 52)->down);
+  EXPECT_TRUE(synth.voice(1, 52)->down);
+  // Sustain over a re-strike: the key is held again, then sustained, then released by the pedal.
+  render(synth, {{0.0, cc(64, 127)}, {0.0, on(51)}, {0.01, off(51)}, {0.02, on(51)}}, 0.05, 64);
+  EXPECT_TRUE(synth.voice(1, 51)->down);
+  EXPECT_FALSE(synth.voice(1, 51)->sustained);
+  render(synth, {{0.0, off(51)}}, 0.01, 64);
+  EXPECT_TRUE(synth.voice(1, 51)->sustained);
+  render(synth, {{0.0, cc(64, 0)}}, 1.0, 64);
+  EXPECT_FALSE(synth.voice(1, 51)->sounding());
+}
+
+// A chord struck at once never steals its own notes: a key just struck counts as loud.
+TEST(Synth, AChordDoesNotStealItself) {
+  Synth synth = prepared({pianoKeys(48, 60, 2)});
+  render(synth, {{0.0, on(48, 127)}}, 0.5, 64);
+  render(synth, {{0.0, on(52, 40)}, {0.0, on(55, 40)}}, 0.05, 64);
+  EXPECT_TRUE(synth.voice(0, 52)->sounding());
+  EXPECT_TRUE(synth.voice(0, 55)->sounding());
+  EXPECT_FALSE(synth.voice(0, 48)->sounding() && !synth.voice(0, 48)->fading());
 }
 
 // A note-on at offset 37 of a block starts exactly there: the output before it is silent.
@@ -225,6 +276,9 @@ TEST(Synth, FlushToZeroIsOnWhileProcessingAndRestoredAfter) {
 
 TEST(Synth, RejectsBadSetups) {
   Synth synth;
+  Instrument silent = pianoKeys(60, 60, 0);
+  EXPECT_THROW(synth.prepare({silent}, {.sampleRate = kRate, .maxBlock = 64, .notes = {}}),
+               std::invalid_argument);
   EXPECT_THROW(synth.prepare({}, {}), std::invalid_argument);
   EXPECT_THROW(
       synth.prepare({pianoKeys(60, 60)}, {.sampleRate = kRate, .maxBlock = 0, .notes = {}}),
