@@ -145,9 +145,9 @@ int play(const PlayArguments& a) {
     if (!status) continue;
     const Player::Status s = player.status();
     std::fprintf(stderr,
-                 "\r  voices %2d/%-3d  cpu %3.0f%% (peak %3.0f%%)  underruns %ld  midi %-12s  "
-                 "guard %d   ",
-                 s.voices, s.limit, 100.0 * s.load, 100.0 * s.peakLoad, audio.underruns(),
+                 "\r  voices %2d/%-3d  cpu %3.0f%% (peak %3.0f%%)  underruns %ld (late %ld)  "
+                 "midi %-12s  guard %d   ",
+                 s.voices, s.limit, 100.0 * s.load, 100.0 * s.peakLoad, audio.underruns(), s.late,
                  describe(s.lastMessage).c_str(), s.guardEvents);
     std::fflush(stderr);
   }
@@ -156,13 +156,15 @@ int play(const PlayArguments& a) {
   const Player::Status s = player.status();
   if (status) std::fprintf(stderr, "\n");
   std::fprintf(stderr,
-               "hamiltone-play: stopped by %s; underruns %ld; peak cpu %.0f%%; guard events %d\n",
-               signal == SIGINT ? "SIGINT" : "SIGTERM", audio.underruns(), 100.0 * s.peakLoad,
-               s.guardEvents);
+               "hamiltone-play: stopped by %s; underruns %ld; late callbacks %ld; peak cpu %.0f%%; "
+               "guard events %d\n",
+               signal == SIGINT ? "SIGINT" : "SIGTERM", audio.underruns(), s.late,
+               100.0 * s.peakLoad, s.guardEvents);
   if (recorder) {
     const double seconds = recorder->finish();
-    std::fprintf(stderr, "hamiltone-play: recorded %.2f s to %s%s\n", seconds, a.record.c_str(),
-                 s.recordDropped ? " (with gaps: the disk fell behind)" : "");
+    std::fprintf(stderr, "hamiltone-play: recorded %.2f s to %s%s%s\n", seconds, a.record.c_str(),
+                 s.recordDropped ? " (with gaps: the disk fell behind)" : "",
+                 recorder->truncatedFrames() ? " (cut at the 4 GiB a WAV file holds)" : "");
   }
   return 0;
 }

@@ -25,6 +25,7 @@ Player::Player(Synth& synth, SpscQueue<StampedMessage>& midi, SpscQueue<float>* 
 void Player::render(float* interleaved, int frames, std::int64_t nowNs) noexcept {
   const auto start = std::chrono::steady_clock::now();
   frames = std::min(frames, static_cast<int>(left_.size()));
+  if (frames <= 0) return;
   // The block stands for the buffer period that ended now: [now − P, now).
   const double period = frames / sampleRate_;
   int count = 0;
@@ -53,6 +54,7 @@ void Player::render(float* interleaved, int frames, std::int64_t nowNs) noexcept
   const double busy =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const double load = busy / period;
+  if (load > 1.0) late_.fetch_add(1, std::memory_order_relaxed);
   protect(load, period);
   load_.store(load, std::memory_order_relaxed);
   if (load > peak_.load(std::memory_order_relaxed)) peak_.store(load, std::memory_order_relaxed);
@@ -85,6 +87,7 @@ Player::Status Player::status() const {
   s.load = load_.load();
   s.peakLoad = peak_.load();
   s.recordDropped = recordDropped_.load();
+  s.late = late_.load();
   s.lastMessage = last_.load();
   return s;
 }

@@ -38,6 +38,7 @@ class Player {
     int voices = 0, limit = 0, guardEvents = 0;
     double load = 0.0, peakLoad = 0.0;  // compute time / buffer period
     long recordDropped = 0;             // samples the recording ring had no room for
+    long late = 0;                      // blocks whose compute time exceeded their period
     std::uint32_t lastMessage = 0;      // status << 16 | data1 << 8 | data2; 0 before any
   };
   Status status() const;  // from any thread
@@ -55,7 +56,7 @@ class Player {
   double reliefTime_ = 0.0;
   std::atomic<int> voices_{0}, limitShown_{0}, guard_{0};
   std::atomic<double> load_{0.0}, peak_{0.0};
-  std::atomic<long> recordDropped_{0};
+  std::atomic<long> recordDropped_{0}, late_{0};
   std::atomic<std::uint32_t> last_{0};
 };
 

@@ -1,6 +1,7 @@
 // The recorder's writer thread: it empties the ring every 10 ms into the WAV writer.
 #include "recorder.h"
 
+#include <algorithm>
 #include <chrono>
 #include <vector>
 
@@ -32,8 +33,12 @@ void Recorder::drain() {
   std::vector<float> chunk(8192);
   size_t n;
   while ((n = ring_.pop(chunk.data(), chunk.size())) > 0) {
-    wav_.write(chunk.data(), n / 2);  // frames: the audio thread pushes whole frames
-    frames_ += static_cast<long>(n / 2);
+    // Frames (the audio thread pushes whole ones), up to what a WAV file can hold: 4 GiB of
+    // 24-bit stereo, 4.1 h at 48 kHz; the rest is dropped and counted.
+    const long frames = std::min(static_cast<long>(n / 2), kMaxFrames - frames_);
+    if (frames > 0) wav_.write(chunk.data(), static_cast<size_t>(frames));
+    frames_ += std::max(frames, 0L);
+    truncated_ += static_cast<long>(n / 2) - std::max(frames, 0L);
   }
 }
 

@@ -15,6 +15,7 @@ namespace hamiltone::app {
 class Recorder {
  public:
   static constexpr double kRingSeconds = 10.0;  // of stereo audio the writer may fall behind
+  static constexpr long kMaxFrames = (4294967295L - 1024L) / 6;  // 24-bit stereo in 4 GiB
 
   // Creates the temporary now (so a bad path fails before playing); throws cli::UsageError.
   Recorder(const std::string& path, int sampleRate);
@@ -24,6 +25,7 @@ class Recorder {
   // Stops the writer once the ring is drained and renames the file into place. Returns the
   // seconds recorded.
   double finish();
+  long truncatedFrames() const { return truncated_; }  // past kMaxFrames, not written
 
  private:
   void drain();
@@ -32,7 +34,7 @@ class Recorder {
   SpscQueue<float> ring_;
   std::thread writer_;
   std::atomic<bool> stopping_{false};
-  long frames_ = 0;
+  long frames_ = 0, truncated_ = 0;
   int sampleRate_;
   bool finished_ = false;
 };

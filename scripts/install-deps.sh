@@ -12,7 +12,9 @@ packages=(
   librtaudio-dev librtmidi-dev  # app/: hamiltone-play's audio output and MIDI input
   libgtest-dev libgmock-dev  # tests/
   clang libclang-rt-14-dev   # tests/fuzz: libFuzzer targets for the MIDI reader and preset loader
+  clang-22 libclang-rt-22-dev llvm-22  # tests/rtsan: RTSan test (bookworm-security; llvm-22 symbolises)
   libbenchmark-dev    # bench/
+  jackd2              # tests/e2e: a JACK server (dummy driver) for hamiltone-play's test
 )
 
 missing=()

@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "support/spectrum.h"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -79,38 +81,11 @@ std::string preset(const char* name) {
   return std::string(HAMILTONE_SOURCE_DIR) + "/presets/" + name + ".toml";
 }
 
-// |Σ w[n] x[n] e^{−iωn}| of the left channel, Hann window w.
-double magnitude(const std::vector<double>& x, double hz, double rate) {
-  double re = 0.0, im = 0.0;
-  const double n = static_cast<double>(x.size());
-  for (size_t i = 0; i < x.size(); ++i) {
-    const double w = 0.5 - 0.5 * std::cos(2.0 * std::numbers::pi * i / n);
-    const double phase = 2.0 * std::numbers::pi * hz * i / rate;
-    re += w * x[i] * std::cos(phase);
-    im -= w * x[i] * std::sin(phase);
-  }
-  return std::hypot(re, im);
-}
-
-// The spectral peak within ±30 cents of `expected`, by golden-section search: for a partial
-// isolated from its neighbours (an octave away) the Hann-windowed peak sits on its frequency.
-double peakFrequency(const std::vector<double>& x, double expected, double rate) {
-  double a = expected * std::pow(2.0, -30.0 / 1200.0), b = expected * std::pow(2.0, 30.0 / 1200.0);
-  const double g = (std::sqrt(5.0) - 1.0) / 2.0;
-  for (int i = 0; i < 60; ++i) {
-    const double c = b - g * (b - a), d = a + g * (b - a);
-    if (magnitude(x, c, rate) > magnitude(x, d, rate))
-      b = d;
-    else
-      a = c;
-  }
-  return 0.5 * (a + b);
-}
-
 TEST_F(RenderCli, WritesTheRequestedRateChannelsFormatAndLength) {
   const Result r = run("--preset " + preset("paper-c3-string") +
                        " --notes C3:100:0.5 --tail 0.25 --sample-rate 44100 --format pcm16 "
-                       "--quiet -o " + wav());
+                       "--quiet -o " +
+                       wav());
   ASSERT_EQ(r.exitCode, 0) << r.err;
   EXPECT_EQ(r.err, "");  // --quiet
   const Wav w = read(wav());
@@ -120,7 +95,9 @@ TEST_F(RenderCli, WritesTheRequestedRateChannelsFormatAndLength) {
   EXPECT_EQ(w.info.frames, std::lround(0.75 * 44100));
   for (const char* format : {"pcm24", "float32"}) {
     ASSERT_EQ(run("--preset " + preset("paper-c3-string") + " --notes C3 --tail 0 --format " +
-                  format + " -o " + wav()).exitCode, 0);
+                  format + " -o " + wav())
+                  .exitCode,
+              0);
     const Wav f = read(wav());
     EXPECT_EQ(f.info.format & SF_FORMAT_SUBMASK,
               std::string(format) == "pcm24" ? SF_FORMAT_PCM_24 : SF_FORMAT_FLOAT);
@@ -142,14 +119,15 @@ TEST_F(RenderCli, RenderedNotesAreInTuneWithinOneCent) {
     const Wav w = read(wav());
     std::vector<double> left;
     for (sf_count_t i = 24000; i < w.info.frames; ++i) left.push_back(w.samples[2 * i]);
-    const double measured = peakFrequency(left, note.hz, 48000.0);
+    const double measured = hamiltone::testing::peakFrequency(left, note.hz, 48000.0);
     EXPECT_NEAR(1200.0 * std::log2(measured / note.hz), 0.0, 1.0) << note.name;
   }
 }
 
 TEST_F(RenderCli, PlaysTheBundledDemoMidiFile) {
-  const Result r = run("--preset " + preset("paper-c3-string") + " --midi " +
-                       HAMILTONE_SOURCE_DIR "/presets/demo.mid --tail 0.5 --block 1000 -o " + wav());
+  const Result r =
+      run("--preset " + preset("paper-c3-string") + " --midi " +
+          HAMILTONE_SOURCE_DIR "/presets/demo.mid --tail 0.5 --block 1000 -o " + wav());
   ASSERT_EQ(r.exitCode, 0) << r.err;
   EXPECT_NE(r.err.find("real-time factor"), std::string::npos) << r.err;
   const Wav w = read(wav());
@@ -158,7 +136,7 @@ TEST_F(RenderCli, PlaysTheBundledDemoMidiFile) {
 
 TEST_F(RenderCli, RefusesBadInputAndWritesNothing) {
   const std::string c3 = " --preset " + preset("paper-c3-string");
-  expectRefused(c3, "--midi");                                   // neither --midi nor --notes
+  expectRefused(c3, "--midi");                                    // neither --midi nor --notes
   expectRefused(c3 + " --notes C3 --midi x.mid", "exactly one");  // both
   expectRefused(c3 + " --notes H3", "unknown note name");
   expectRefused(c3 + " --notes C3 --sample-rate 1000", "--sample-rate");
@@ -180,7 +158,8 @@ TEST_F(RenderCli, RefusesBadInputAndWritesNothing) {
 
 TEST_F(RenderCli, ListsTheParameterTable) {
   const std::string out = (dir_ / "params.txt").string();
-  const int status = std::system((std::string(HAMILTONE_RENDER) + " --list-params >" + out).c_str());
+  const int status =
+      std::system((std::string(HAMILTONE_RENDER) + " --list-params >" + out).c_str());
   ASSERT_EQ(WEXITSTATUS(status), 0);
   std::ifstream in(out);
   std::stringstream s;

@@ -1,6 +1,7 @@
 // No scheme allocates while stepping or reporting energy: Eigen's EIGEN_RUNTIME_NO_MALLOC guard,
 // armed in this binary (see tests/CMakeLists.txt), aborts on any heap allocation through Eigen,
-// and this binary's operator new counts every other allocation made while it is forbidden.
+// and this binary's operator new counts every other allocation made while it is forbidden. The
+// audio path built on them is held to the same: voices, the synthesizer and the live player.
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -14,6 +15,7 @@
 #include "models/plate.h"
 #include "presets/piano_scale.h"
 #include "support/fpu_runs.h"
+#include "support/player_performance.h"
 #include "support/test_instruments.h"
 #include "synth/synth.h"
 #include "voices/plate_voice.h"
@@ -201,6 +203,32 @@ TEST(NoAllocation, SynthProcess) {
   forbidAllocation(false);
   EXPECT_EQ(forbiddenNews - before, 0);
   EXPECT_EQ(synth.guardEvents(), 0);
+}
+
+// The audio callback's work (app/player.cpp): the MIDI queue drained onto sample offsets, the
+// synthesizer, the recording tee and the load measurement, over the rate × block-size grid.
+TEST(NoAllocation, PlayerRender) {
+  for (double rate : {44100.0, 48000.0, 96000.0}) {
+    Synth synth;
+    synth.prepare(testing::performanceInstruments(HAMILTONE_SOURCE_DIR),
+                  testing::performanceSetup(rate));
+    for (int frames : {1, 64, 256, 1024}) {
+      SCOPED_TRACE(::testing::Message() << rate << " Hz, " << frames << " frames");
+      synth.setPolyphony(0);
+      SpscQueue<app::StampedMessage> midi(256);
+      SpscQueue<float> record(2 * static_cast<size_t>(rate));
+      app::Player player(synth, midi, &record, rate, frames);
+      std::vector<float> interleaved(2 * static_cast<size_t>(frames)), drained(2 * 1024);
+      const long before = forbiddenNews;
+      forbidAllocation(true);
+      testing::playPerformance(
+          player, midi, rate, frames, interleaved,
+          [&](std::span<const float>) { record.pop(drained.data(), drained.size()); });
+      forbidAllocation(false);
+      EXPECT_EQ(forbiddenNews - before, 0);
+      EXPECT_EQ(player.status().recordDropped, 0);
+    }
+  }
 }
 
 TEST(NoAllocation, MarazzatoWithEveryQuadrature) {
