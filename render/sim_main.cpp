@@ -6,6 +6,7 @@
 #include <exception>
 
 #include "fpu_command.h"
+#include "particle_command.h"
 #include "plate_command.h"
 #include "string_command.h"
 #include "usage_error.h"
@@ -22,6 +23,8 @@ int main(int argc, char** argv) {
   CLI::App* stringCommand = addStringCommand(app, string);
   PlateArguments plate;
   CLI::App* plateCommand = addPlateCommand(app, plate);
+  ParticleArguments particle;
+  CLI::App* particleCommand = addParticleCommand(app, particle);
 
   try {
     app.parse(argc, argv);
@@ -38,6 +41,7 @@ int main(int argc, char** argv) {
     if (fpuCommand->parsed()) return runFpuCommand(fpu);
     if (stringCommand->parsed()) return runStringCommand(string);
     if (plateCommand->parsed()) return runPlateCommand(plate);
+    if (particleCommand->parsed()) return runParticleCommand(particle);
   } catch (const UsageError& e) {
     std::fprintf(stderr, "hamiltone-sim %s: %s\n",
                  app.get_subcommands().front()->get_name().c_str(), e.what());
