@@ -14,6 +14,7 @@
 #include "models/hammer.h"
 #include "models/plate.h"
 #include "presets/piano_scale.h"
+#include "schemes/variable_step_sav.h"
 #include "support/fpu_runs.h"
 #include "support/player_performance.h"
 #include "support/test_instruments.h"
@@ -114,6 +115,21 @@ void strikeWithoutAllocating(GridRule rule, auto makeScheme) {
   start.p[system.hammerIndex()] = 0.03;
   auto scheme = makeScheme(system, StepParameters{.k = k, .sigma0 = 1.0, .sigma1 = 1e-3}, start);
   stepWithoutAllocating(scheme);
+}
+
+TEST(NoAllocation, VariableStepSav) {
+  VariableStepSav<FermiPastaUlam> s(chain(), start(), 1.0);
+  s.step(1e-3);  // the start (21)
+  double sink = 0.0;
+  const long before = forbiddenNews;
+  forbidAllocation(true);
+  for (int n = 0; n < 1000; ++n) {
+    s.step(n % 2 ? 0.5e-3 : 1.5e-3);
+    sink += s.energy().total();
+  }
+  forbidAllocation(false);
+  EXPECT_EQ(forbiddenNews - before, 0);
+  EXPECT_TRUE(std::isfinite(sink));
 }
 
 TEST(NoAllocation, SchemesOnTheStruckString) {
