@@ -5,9 +5,11 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <type_traits>
 
 #include "atomic_file.h"
 #include "csv_run.h"
+#include "models/discrete_gradient_string.h"
 #include "models/hammer.h"
 #include "models/string.h"
 #include "number_arguments.h"
@@ -22,8 +24,11 @@ CLI::App* addStringCommand(CLI::App& app, StringArguments& a) {
       "Geometrically exact string (BDZ (56), split (65)), transverse u and longitudinal v, fixed "
       "ends. Start (70): u = α sqrt(A) sin(πx/L), v = 0, at rest; or --alpha 0 "
       "--hammer-velocity V: struck by a felt hammer (C3 law) at 0.12 L.");
-  cmd->add_option("--scheme", a.scheme, "sv: Störmer–Verlet (66); sav-split: split scheme (38)")
-      ->check(CLI::IsMember({"sv", "sav-split"}))
+  cmd->add_option("--scheme", a.scheme,
+                  "sv: Störmer–Verlet (66); sav-split: split scheme (38); implicit: the "
+                  "discrete-gradient scheme (67)–(68) with Newton–Raphson (tolerance 1e-13, at "
+                  "most 20 iterations), lossless, no hammer")
+      ->check(CLI::IsMember({"sv", "sav-split", "implicit"}))
       ->capture_default_str();
   cmd->add_option("--grid", a.grid,
                   "longitudinal: h >= sqrt(E/ρ) k (the paper's); transverse: the finest grid the "
@@ -60,10 +65,10 @@ CLI::App* addStringCommand(CLI::App& app, StringArguments& a) {
   cmd->footer(
       "CSV: a comment line '# segments=M h=... k=...', a header, then one row per written step\n"
       "  n: t,u,v,energy,psi. t = n k; u, v = u^n, v^n at the grid point nearest probe·L;\n"
-      "  energy = H^{n+1/2} of (41) (sv: (41) with ψ = 0 plus V'(u^n, v^n)), with the gauge\n"
-      "  shift ε excluded; psi = ψ^{n+1/2} of the string's potential (0 for sv;\n"
-      "  a hammer strike has a second ψ, the felt's, which is not written). With loss,\n"
-      "  energy + dissipated is what stays constant.\n" +
+      "  energy = H^{n+1/2} of (41) (sv: (41) with ψ = 0 plus V'(u^n, v^n); implicit: the\n"
+      "  energy (67)–(68) conserve), with the gauge shift ε excluded; psi = ψ^{n+1/2} of the\n"
+      "  string's potential (0 for sv and implicit; a hammer strike has a second ψ, the felt's,\n"
+      "  which is not written). With loss, energy + dissipated is what stays constant.\n" +
       std::string(kRunFooter));
   return cmd;
 }
@@ -95,6 +100,11 @@ RunSummary run(const std::string& scheme, const System& system, const InitialSta
   if (scheme == "sv")
     return simulate(building([&] { return StormerVerlet<System>(system, params, start); }), probe,
                     steps, every, out);
+  if constexpr (std::is_same_v<System, NonlinearString>) {
+    if (scheme == "implicit")
+      return simulate(building([&] { return DiscreteGradientString(system, params.k, start); }),
+                      probe, steps, every, out);
+  }
   return simulate(building([&] { return SplitSav<System>(system, params, start); }), probe, steps,
                   every, out);
 }
@@ -126,8 +136,12 @@ int runStringCommand(const StringArguments& a) {
   if (hammerVelocity > 0.0 && alpha != 0.0)
     throw UsageError("--hammer-velocity = " + a.hammerVelocity +
                      ": a strike starts from rest; give --alpha 0 with it");
-  if (epsilon != 0.0 && a.scheme == "sv")
+  if (epsilon != 0.0 && a.scheme != "sav-split")
     throw UsageError("--epsilon = " + a.epsilon + ": the gauge shift applies to sav-split only");
+  if (a.scheme == "implicit" && (hammerVelocity > 0.0 || sigma0 > 0.0 || sigma1 > 0.0))
+    throw UsageError(
+        "--scheme implicit: the reference (67) is lossless and unstruck; give it "
+        "no --hammer-velocity, --sigma0 or --sigma1");
   const long steps = stepCount(duration, k);
   checkOutputSize(steps, every, 5);
 

@@ -1,5 +1,6 @@
 // `hamiltone-sim string`: the geometrically exact string of BDZ §4.2, started in its first mode
-// (70) or struck by a felt hammer, with Störmer–Verlet (66) or the split scheme (38).
+// (70) or struck by a felt hammer, with Störmer–Verlet (66), the split scheme (38) or the implicit
+// discrete-gradient reference (67)–(68).
 #pragma once
 
 #include <CLI/App.hpp>

@@ -236,6 +236,36 @@ TEST_F(SimCli, StringWritesTheDocumentedCsv) {
   }
 }
 
+// The implicit reference (67)–(68) writes the same columns and conserves its energy; its u tracks
+// the split scheme's on the same grid and step.
+TEST_F(SimCli, StringImplicitReferenceWritesTheSameCsv) {
+  const std::string common = "string --segments 40 --k 2e-6 --alpha 300 --duration 2e-4 --every 10";
+  const Result r = run(common + " --scheme implicit --out " + csv());
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  std::istringstream text(slurp(csv()));
+  std::string comment;
+  std::getline(text, comment);
+  EXPECT_EQ(comment.rfind("# segments=40 ", 0), 0u) << comment;
+  std::string rest((std::istreambuf_iterator<char>(text)), std::istreambuf_iterator<char>());
+  std::string header;
+  const auto rows = parseRows(rest, header);
+  EXPECT_EQ(header, "t,u,v,energy,psi");
+  ASSERT_EQ(rows.size(), 11u);  // 100 steps, every 10
+  for (const auto& row : rows) {
+    ASSERT_EQ(row.size(), 5u);
+    EXPECT_NEAR(row[3], rows[0][3], 1e-10 * rows[0][3]);
+    EXPECT_EQ(row[4], 0.0);
+  }
+  ASSERT_EQ(run(common + " --scheme sav-split --out " + csv()).exitCode, 0);
+  std::istringstream other(slurp(csv()));
+  std::getline(other, comment);
+  std::string rest2((std::istreambuf_iterator<char>(other)), std::istreambuf_iterator<char>());
+  const auto sav = parseRows(rest2, header);
+  ASSERT_EQ(sav.size(), rows.size());
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    EXPECT_NEAR(rows[i][1], sav[i][1], 1e-3 * std::abs(rows[0][1])) << "row " << i;
+}
+
 TEST_F(SimCli, StringStrikeWithTheHammer) {
   const Result r =
       run("string --grid transverse --k 2.0833333333e-5 --stiffness on --alpha 0 "
@@ -255,6 +285,9 @@ TEST_F(SimCli, StringRefusesBadInput) {
   expectRefused(ok + " --rho -1", "--rho");
   expectRefused(ok + " --hammer-velocity 3", "--hammer-velocity");
   expectRefused(ok + " --scheme sv --epsilon 1", "--epsilon");
+  expectRefused(ok + " --scheme implicit --epsilon 1", "--epsilon");
+  expectRefused(ok + " --scheme implicit --sigma0 1", "implicit");
+  expectRefused(ok + " --scheme implicit --alpha 0 --hammer-velocity 3", "implicit");
   expectRefused(ok + " --segments 1", "--segments");
   expectRefused(ok + " --segments 100000 --k 1e-5", "(44)");
   expectRefused(ok + " --length 1e-4", "length");
