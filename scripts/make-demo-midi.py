@@ -16,6 +16,8 @@ import argparse
 import pathlib
 import struct
 
+from smf import chunk, variable_length
+
 DIVISION = 480  # ticks per quarter note
 BAR = 4 * DIVISION
 LEGATO = 0.95  # a note sounds for this fraction of its written length
@@ -56,16 +58,6 @@ def dynamics(beat):
     return round(120 - (120 - 30) * (beat - 18) / 14)
 
 
-def variable_length(value):
-    """A MIDI variable-length number: 7 bits a byte, the top bit set on all but the last."""
-    out = [value & 0x7F]
-    value >>= 7
-    while value:
-        out.append(0x80 | (value & 0x7F))
-        value >>= 7
-    return bytes(reversed(out))
-
-
 def meta(kind, data):
     return bytes([0xFF, kind]) + variable_length(len(data)) + data
 
@@ -87,7 +79,7 @@ def track_chunk(events):
         else:
             running = event[0]
             body += event
-    return b"MTrk" + struct.pack(">I", len(body)) + bytes(body)
+    return chunk(b"MTrk", bytes(body))
 
 
 def tempo_track(end):
@@ -126,7 +118,7 @@ def piano_track(end):
 
 def demo():
     end = len(HARMONY) * BAR
-    header = b"MThd" + struct.pack(">IHHH", 6, 1, 2, DIVISION)
+    header = chunk(b"MThd", struct.pack(">HHH", 1, 2, DIVISION))
     return header + tempo_track(end) + piano_track(end)
 
 

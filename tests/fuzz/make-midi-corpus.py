@@ -10,18 +10,8 @@ import pathlib
 import struct
 import sys
 
-
-def variable_length(value):
-    out = [value & 0x7F]
-    value >>= 7
-    while value:
-        out.append(0x80 | (value & 0x7F))
-        value >>= 7
-    return bytes(reversed(out))
-
-
-def chunk(kind, data):
-    return kind + struct.pack(">I", len(data)) + data
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "scripts"))
+from smf import chunk, variable_length  # noqa: E402
 
 
 def header(fmt, tracks, division):
