@@ -47,8 +47,13 @@ class SavScheme {
     prev_ = start.q;
     fullGradient(system_, prev_, grads_[0], kq_);
     loss_.taylorStart(system_, start, grads_[0], curr_);
-    // ψ^{½} = sqrt(2 (V'(q^{½}) + ε)) with q^{½} = (q^0 + q^1)/2: second order, like (32).
-    next_ = 0.5 * (prev_ + curr_);
+    // ψ^{½} = sqrt(2 (V'(q^{½}) + ε)) with q^{½} = q(k/2) + O(k³), the Taylor start (21) taken to
+    // half a step: q^0 + (k/2) v^0 + (k²/8) a^0 with a^0 = 2(q^1 − q^0 − k v^0)/k² (loss included)
+    // is (3q^0 + q^1)/4 + (k/4) v^0. The mean (q^0 + q^1)/2 is off by (k²/8) a^0, an error the
+    // exactly conserved energy then keeps for the whole run: on the FPU chain at α = 100 it made
+    // (38) 9× less accurate than Störmer–Verlet, where BDZ Fig. 3 has the two track each other.
+    next_ = 0.75 * prev_ + 0.25 * curr_ +
+            (0.25 * params_.k) * system_.inverseMass().cwiseProduct(start.p);
     for (int j = 0; j < parts; ++j)
       psi_[j] = std::sqrt(2.0 * (quadratisedPotential(j, next_) + params_.epsilon));
   }
