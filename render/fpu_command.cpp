@@ -9,11 +9,14 @@
 #include "atomic_file.h"
 #include "csv_run.h"
 #include "models/fpu.h"
+#include "models/slow_fast_fpu.h"
 #include "number_arguments.h"
+#include "schemes/asynchronous_marazzato.h"
 #include "schemes/marazzato.h"
 #include "schemes/sav.h"
 #include "schemes/stormer_verlet.h"
 #include "usage_error.h"
+#include "util/format_number.h"
 
 namespace hamiltone::cli {
 
@@ -25,11 +28,15 @@ CLI::App* addFpuCommand(CLI::App& app, FpuArguments& a) {
   fpu->add_option("--scheme", a.scheme,
                   "sv: Störmer–Verlet (20); sav: explicit SAV (27); sav-split: split-potential "
                   "SAV (38), needs k <= 2/ω (54); marazzato: Marazzato et al. (22)")
-      ->required()
       ->check(CLI::IsMember({"sv", "sav", "sav-split", "marazzato"}));
+  fpu->add_flag("--slow-fast", a.slowFast,
+                "the slow/fast chain of [M §4.3.1] (m linear springs, then m + 1 quartic ones) on "
+                "the asynchronous scheme [M (21)–(25)], steps --hs and --hf; replaces --scheme");
+  fpu->add_flag("--sync", a.sync,
+                "with --slow-fast: the synchronous scheme [M (6)] at h_F on the same chain");
   fpu->add_option("--quadrature", a.quadrature,
-                  "force quadrature of marazzato (default midpoint); gl2, gl3, gl5 are "
-                  "Gauss–Legendre, lobatto3, lobatto5 Gauss–Lobatto")
+                  "force quadrature of marazzato (default midpoint) and --slow-fast (default "
+                  "lobatto5); gl2, gl3, gl5 are Gauss–Legendre, lobatto3, lobatto5 Gauss–Lobatto")
       ->check(CLI::IsMember({"midpoint", "gl2", "gl3", "gl5", "lobatto3", "lobatto5"}));
   // Numbers are taken as text and parsed strictly by runFpuCommand, whose messages say what
   // is valid.
@@ -39,8 +46,12 @@ CLI::App* addFpuCommand(CLI::App& app, FpuArguments& a) {
   number("--k", a.k, "SECONDS", "time step (> 0)");
   number("--duration", a.duration, "SECONDS", "simulated time (> 0)");
   number("--alpha", a.alpha, "NUMBER", "initial displacement of coordinate 4");
-  number("--omega", a.omega, "RAD/S", "linear spring frequency ω (> 0)");
-  number("--pairs", a.pairs, "INT", "number of pairs M (>= 2; N = 2M masses)");
+  number("--omega", a.omega, "RAD/S",
+         "linear spring frequency ω (> 0; default 50, with --slow-fast √10: ω² = 10)");
+  number("--pairs", a.pairs, "INT",
+         "number of pairs M (>= 2; N = 2M masses); with --slow-fast the paper's m (>= 2)");
+  number("--hs", a.hs, "SECONDS", "--slow-fast: coarse step h_S, an integer multiple K of --hf");
+  number("--hf", a.hf, "SECONDS", "--slow-fast: fine step h_F (> 0), within the CFL bound (16)");
   number("--epsilon", a.epsilon, "JOULES", "gauge shift ε of sav, sav-split, §2.5 (>= 0)");
   number("--sigma0", a.sigma0, "1/S",
          "mass-proportional loss σ0, force −2σ0 M q' (>= 0; sv, sav, sav-split)");
@@ -52,7 +63,11 @@ CLI::App* addFpuCommand(CLI::App& app, FpuArguments& a) {
       "  [t^n, t^{n+1}]: H^{n+1/2} of (41) [(36) for sav], kinetic = ½|q^{n+1}−q^n|²/k²,\n"
       "  potential = ½ q^{n+1}·K q^n + ½ψ² − ε (sv: ψ = 0 plus V'(q^n)). For marazzato it is\n"
       "  the pseudo-energy (13) at t^n: kinetic = ½ p^{n−½}·p^{n+½}, potential = V(q^n).\n"
-      "  With loss, energy + dissipated energy is what stays constant (50).\n" +
+      "  With loss, energy + dissipated energy is what stays constant (50).\n"
+      "--slow-fast: rows at the coarse nodes t = n h_S (--sync: t = n h_F), energy = the\n"
+      "  pseudo-energy (26) [(13) with --sync]; the start is q(0) = α e_{m+1}, p(0) = 0. The\n"
+      "  summary adds the counted force evaluations (one spring at one new quadrature node)\n"
+      "  and [M §4.3.1]'s N_s, N_a and η = N_a / N_s for the same run.\n" +
       std::string(kRunFooter));
   return fpu;
 }
@@ -67,14 +82,15 @@ struct FpuRun {
   long every;
 };
 
+// Writes the CSV of `steps` steps of a scheme over `size` coordinates; the scheme is stepped in
+// place, so the caller may read its counters afterwards.
 template <class Scheme>
-RunSummary simulate(Scheme scheme, const FpuRun& run, std::FILE* out) {
+RunSummary simulate(Scheme& scheme, Eigen::Index size, long steps, long every, std::FILE* out) {
   std::fprintf(out, "t");
-  for (Eigen::Index i = 1; i <= run.chain.size(); ++i)
-    std::fprintf(out, ",q%ld", static_cast<long>(i));
+  for (Eigen::Index i = 1; i <= size; ++i) std::fprintf(out, ",q%ld", static_cast<long>(i));
   std::fprintf(out, ",energy,kinetic,potential\n");
   return runToCsv(
-      scheme, run.steps, run.every, out,
+      scheme, steps, every, out,
       [](const Scheme& s, const Energy& e, std::FILE* f) {
         for (double x : s.q()) writeNumber(f, x);
         writeNumber(f, e.total());
@@ -84,14 +100,88 @@ RunSummary simulate(Scheme scheme, const FpuRun& run, std::FILE* out) {
       "--alpha, --omega or --epsilon is");
 }
 
+template <class Scheme>
+RunSummary simulate(Scheme scheme, const FpuRun& run, std::FILE* out) {
+  return simulate(scheme, run.chain.size(), run.steps, run.every, out);
+}
+
+// `fpu --slow-fast`: [M §4.3.1] on AsynchronousMarazzato, or Marazzato at h_F with --sync.
+int runSlowFast(const FpuArguments& a) {
+  if (!a.scheme.empty())
+    throw UsageError("--scheme = " + a.scheme +
+                     ": --slow-fast runs its own schemes; drop --scheme");
+  if (a.k != "1e-3") throw UsageError("--k = " + a.k + ": with --slow-fast use --hs and --hf");
+  if (a.epsilon != "0" || a.sigma0 != "0")
+    throw UsageError("--epsilon / --sigma0: not used by --slow-fast (lossless, no SAV)");
+  const double hs = parseReal("--hs", a.hs, Range::positive, "seconds");
+  const double hf = parseReal("--hf", a.hf, Range::positive, "seconds");
+  const double duration = parseReal("--duration", a.duration, Range::positive, "seconds");
+  const double alpha = parseReal("--alpha", a.alpha, Range::any);
+  const double omega =
+      a.omega.empty() ? std::sqrt(10.0) : parseReal("--omega", a.omega, Range::positive, "rad/s");
+  const long pairs = parseInteger("--pairs", a.pairs, 2, 1'000'000);
+  const long every = parseInteger("--every", a.every, 1);
+  const double ratio = std::round(hs / hf);
+  if (ratio < 1.0 || ratio > 1e9 || std::abs(hs / hf - ratio) > 1e-9 * ratio)
+    throw UsageError("--hs / --hf = " + formatNumber(hs / hf) +
+                     ": h_S must be an integer multiple K >= 1 of h_F");
+  const long k = static_cast<long>(ratio);
+  const QuadratureRule rule =
+      a.quadrature.empty() ? QuadratureRule::lobatto5 : *parseQuadratureRule(a.quadrature);
+  const SlowFastFermiPastaUlam chain =
+      building([&] { return SlowFastFermiPastaUlam(static_cast<int>(pairs), omega); });
+  const double bound = 2.0 / std::sqrt(chain.fastEigenvalueMax());
+  if (hf >= bound)
+    throw UsageError("--hf = " + a.hf + ": the CFL bound (16) of the linear springs is h_F < " +
+                     formatNumber(bound) + " s");
+  const long coarseSteps = stepCount(duration, hs);
+  const long steps = a.sync ? coarseSteps * k : coarseSteps;
+  checkOutputSize(steps, every, 2 * pairs + 4);
+  const InitialState start = building([&] { return slowFastInitialState(chain, alpha); });
+
+  AtomicFile file(a.out, "--out");
+  RunSummary summary;
+  long evaluations = 0;
+  if (a.sync) {
+    Marazzato scheme(WholeSystem{chain}, StepParameters{.k = hf}, start, rule);
+    summary = simulate(scheme, chain.size(), steps, every, file.stream());
+    evaluations = scheme.forceEvaluations();
+  } else {
+    AsynchronousMarazzato scheme(chain, hf, k, start, rule);
+    summary = simulate(scheme, chain.size(), steps, every, file.stream());
+    evaluations = scheme.forceEvaluations();
+  }
+  file.commit();
+
+  printSummary("fpu",
+               std::string(a.sync ? "synchronous" : "asynchronous") + " slow/fast, " +
+                   std::to_string(pairs) + " pairs, h_S = " + a.hs + " s, h_F = " + a.hf +
+                   " s, K = " + std::to_string(k),
+               a.out, summary);
+  // [M §4.3.1]: N_s = (n−1) T (2m+1)/h_F, N_a = (n−1) T ((m+1)/h_F + m/h_S), T = the run's.
+  const double nodes = static_cast<double>(nodesPerInterval(quadrature(rule)));
+  const double t = static_cast<double>(coarseSteps) * hs, m = static_cast<double>(pairs);
+  const double ns = nodes * t * (2.0 * m + 1.0) / hf, na = nodes * t * ((m + 1.0) / hf + m / hs);
+  std::printf("force evaluations: %ld\n", evaluations);
+  std::printf("paper N_s: %.17g\npaper N_a: %.17g\n", ns, na);
+  std::printf("paper eta: %.17g\n", (1.0 + m / ((m + 1.0) * ratio)) / (1.0 + m / (m + 1.0)));
+  return 0;
+}
+
 }  // namespace
 
 int runFpuCommand(const FpuArguments& a) {
+  if (a.slowFast) return runSlowFast(a);
+  if (a.sync) throw UsageError("--sync: applies to --slow-fast only");
+  if (a.scheme.empty()) throw UsageError("--scheme is required (or --slow-fast)");
   const double k = parseReal("--k", a.k, Range::positive, "seconds");
   const double duration = parseReal("--duration", a.duration, Range::positive, "seconds");
   const double alpha = parseReal("--alpha", a.alpha, Range::any);
-  const double omega = parseReal("--omega", a.omega, Range::positive, "rad/s");
+  const double omega =
+      a.omega.empty() ? 50.0 : parseReal("--omega", a.omega, Range::positive, "rad/s");
   const long pairs = parseInteger("--pairs", a.pairs, 2, 1'000'000);
+  if (a.hs != "1e-2" || a.hf != "2e-4")
+    throw UsageError("--hs / --hf: apply to --slow-fast only; use --k");
   const double epsilon = parseReal("--epsilon", a.epsilon, Range::nonNegative, "J");
   const double sigma0 = parseReal("--sigma0", a.sigma0, Range::nonNegative, "1/s");
   const long every = parseInteger("--every", a.every, 1);

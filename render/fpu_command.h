@@ -10,9 +10,12 @@ namespace hamiltone::cli {
 struct FpuArguments {
   std::string scheme;
   std::string quadrature;
-  std::string k = "1e-3", duration = "1", alpha = "1", omega = "50", pairs = "3";
+  std::string k = "1e-3", duration = "1", alpha = "1", omega, pairs = "3";  // ω: 50, or √10
   std::string epsilon = "0", sigma0 = "0", every = "1";
   std::string out;
+  // --slow-fast: the chain of [M §4.3.1] on the asynchronous scheme (or --sync: synchronous).
+  bool slowFast = false, sync = false;
+  std::string hs = "1e-2", hf = "2e-4";
 };
 
 // Registers the subcommand and its options on `app`; the returned pointer tells if it was chosen.

@@ -1,5 +1,5 @@
 // `hamiltone-sim plate`: the von Kármán plate of BDZ §4.3, started in its first mode (85), with
-// Störmer–Verlet (82) or the split scheme (38).
+// Störmer–Verlet (82), the split scheme (38) or the linearly implicit reference (83).
 #pragma once
 
 #include <CLI/App.hpp>
@@ -15,6 +15,7 @@ struct PlateArguments {
   std::string young = "2e11", density = "7850", poisson = "0.3", thickness = "0.002", lx = "0.5",
               ly = "0.5";
   std::string sigma0 = "0", sigma1 = "0";
+  std::string snapshots, snapshotOut;  // "t1,t2,…" and the file of the whole fields
   std::string out;
 };
 

@@ -10,6 +10,8 @@
 #include "plate_command.h"
 #include "string_command.h"
 #include "usage_error.h"
+#include "wave_command.h"
+#include "wave_inhomogeneous_command.h"
 
 int main(int argc, char** argv) {
   using namespace hamiltone::cli;
@@ -25,6 +27,10 @@ int main(int argc, char** argv) {
   CLI::App* plateCommand = addPlateCommand(app, plate);
   ParticleArguments particle;
   CLI::App* particleCommand = addParticleCommand(app, particle);
+  WaveInhomogeneousArguments waveInhomogeneous;
+  CLI::App* waveInhomogeneousCommand = addWaveInhomogeneousCommand(app, waveInhomogeneous);
+  WaveArguments wave;
+  CLI::App* waveCommand = addWaveCommand(app, wave);
 
   try {
     app.parse(argc, argv);
@@ -42,6 +48,8 @@ int main(int argc, char** argv) {
     if (stringCommand->parsed()) return runStringCommand(string);
     if (plateCommand->parsed()) return runPlateCommand(plate);
     if (particleCommand->parsed()) return runParticleCommand(particle);
+    if (waveInhomogeneousCommand->parsed()) return runWaveInhomogeneousCommand(waveInhomogeneous);
+    if (waveCommand->parsed()) return runWaveCommand(wave);
   } catch (const UsageError& e) {
     std::fprintf(stderr, "hamiltone-sim %s: %s\n",
                  app.get_subcommands().front()->get_name().c_str(), e.what());

@@ -2,10 +2,13 @@
 #include "string_command.h"
 
 #include <CLI/Validators.hpp>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <optional>
 #include <type_traits>
+#include <vector>
 
 #include "atomic_file.h"
 #include "csv_run.h"
@@ -15,6 +18,7 @@
 #include "number_arguments.h"
 #include "schemes/sav.h"
 #include "schemes/stormer_verlet.h"
+#include "snapshots.h"
 
 namespace hamiltone::cli {
 
@@ -61,6 +65,14 @@ CLI::App* addStringCommand(CLI::App& app, StringArguments& a) {
   number("--tension", a.tension, "N", "tension T0 (> 0)");
   number("--sigma0", a.sigma0, "1/S", "frequency-independent loss σ0 (>= 0)");
   number("--sigma1", a.sigma1, "M2/S", "frequency-dependent loss σ1 (>= 0)");
+  cmd->add_option("--snapshots", a.snapshots,
+                  "times at which the whole string is written to --snapshot-out, comma-separated "
+                  "(>= 0, <= --duration); each at the first step at or after it")
+      ->type_name("T1,T2,...");
+  cmd->add_option("--snapshot-out", a.snapshotOut,
+                  "CSV of the snapshots: t,x,u,v, one row per grid node (the fixed ends "
+                  "included) per snapshot; written whole or not at all")
+      ->type_name("PATH");
   addOutputOption(cmd, a.out);
   cmd->footer(
       "CSV: a comment line '# segments=M h=... k=...', a header, then one row per written step\n"
@@ -68,7 +80,9 @@ CLI::App* addStringCommand(CLI::App& app, StringArguments& a) {
       "  energy = H^{n+1/2} of (41) (sv: (41) with ψ = 0 plus V'(u^n, v^n); implicit: the\n"
       "  energy (67)–(68) conserve), with the gauge shift ε excluded; psi = ψ^{n+1/2} of the\n"
       "  string's potential (0 for sv and implicit; a hammer strike has a second ψ, the felt's,\n"
-      "  which is not written). With loss, energy + dissipated is what stays constant.\n" +
+      "  which is not written). With loss, energy + dissipated is what stays constant.\n"
+      "Snapshots: a header, then for each time of --snapshots (at the first step n with\n"
+      "  n k >= it) one row per grid node x = j h, j = 0..M: t,x,u,v (u = v = 0 at the ends).\n" +
       std::string(kRunFooter));
   return cmd;
 }
@@ -76,12 +90,15 @@ CLI::App* addStringCommand(CLI::App& app, StringArguments& a) {
 namespace {
 
 template <class Scheme>
-RunSummary simulate(Scheme scheme, Eigen::Index probe, long steps, long every, std::FILE* out) {
+RunSummary simulate(Scheme& scheme, Eigen::Index probe, long steps, long every, std::FILE* out,
+                    Snapshots* snapshots) {
   const Eigen::Index longitudinal = scheme.system().size() / 2;  // u then v (then the hammer)
+  Snapshotting<Scheme> watched(scheme, snapshots);
   std::fprintf(out, "t,u,v,energy,psi\n");
   return runToCsv(
-      scheme, steps, every, out,
-      [&](const Scheme& s, const Energy& e, std::FILE* f) {
+      watched, steps, every, out,
+      [&](const Snapshotting<Scheme>& w, const Energy& e, std::FILE* f) {
+        const Scheme& s = w.scheme();
         writeNumber(f, s.q()[probe]);
         writeNumber(f, s.q()[probe + longitudinal]);
         writeNumber(f, e.total());
@@ -96,17 +113,19 @@ RunSummary simulate(Scheme scheme, Eigen::Index probe, long steps, long every, s
 template <class System>
 RunSummary run(const std::string& scheme, const System& system, const InitialState& start,
                const StepParameters& params, Eigen::Index probe, long steps, long every,
-               std::FILE* out) {
-  if (scheme == "sv")
-    return simulate(building([&] { return StormerVerlet<System>(system, params, start); }), probe,
-                    steps, every, out);
-  if constexpr (std::is_same_v<System, NonlinearString>) {
-    if (scheme == "implicit")
-      return simulate(building([&] { return DiscreteGradientString(system, params.k, start); }),
-                      probe, steps, every, out);
+               std::FILE* out, Snapshots* snapshots) {
+  if (scheme == "sv") {
+    auto sv = building([&] { return StormerVerlet<System>(system, params, start); });
+    return simulate(sv, probe, steps, every, out, snapshots);
   }
-  return simulate(building([&] { return SplitSav<System>(system, params, start); }), probe, steps,
-                  every, out);
+  if constexpr (std::is_same_v<System, NonlinearString>) {
+    if (scheme == "implicit") {
+      auto implicit = building([&] { return DiscreteGradientString(system, params.k, start); });
+      return simulate(implicit, probe, steps, every, out, snapshots);
+    }
+  }
+  auto split = building([&] { return SplitSav<System>(system, params, start); });
+  return simulate(split, probe, steps, every, out, snapshots);
 }
 
 }  // namespace
@@ -144,6 +163,9 @@ int runStringCommand(const StringArguments& a) {
         "no --hammer-velocity, --sigma0 or --sigma1");
   const long steps = stepCount(duration, k);
   checkOutputSize(steps, every, 5);
+  checkSnapshotFlags(a.snapshots, a.snapshotOut, a.out);
+  const std::vector<long> wanted =
+      a.snapshots.empty() ? std::vector<long>{} : snapshotSteps(a.snapshots, k, steps);
 
   const GridRule rule = a.grid == "transverse" ? GridRule::transverse : GridRule::longitudinal;
   const int segments =
@@ -154,7 +176,31 @@ int runStringCommand(const StringArguments& a) {
       std::clamp<Eigen::Index>(std::lround(probe * segments) - 1, 0, segments - 2);
   const StepParameters params{.k = k, .sigma0 = sigma0, .sigma1 = sigma1, .epsilon = epsilon};
 
+  if (!wanted.empty())
+    checkOutputSize(static_cast<long>(wanted.size()) - 1, 1, 4L * (segments + 1));
   AtomicFile file(a.out, "--out");
+  std::optional<AtomicFile> snapshotFile;
+  std::optional<Snapshots> snapshots;
+  if (!wanted.empty()) {
+    snapshotFile.emplace(a.snapshotOut, "--snapshot-out");
+    // t,x,u,v at x = j h, j = 0..M, zero at the fixed ends; q holds u then v (then the hammer).
+    const Eigen::Index interior = segments - 1;
+    const double h = string.spacing();
+    snapshots.emplace(
+        wanted, "t,x,u,v",
+        [segments, interior, h](std::FILE* f, double t, const Vector& q) {
+          for (int j = 0; j <= segments; ++j) {
+            const bool end = j == 0 || j == segments;
+            std::fprintf(f, "%.17g", t);
+            writeNumber(f, j * h);
+            writeNumber(f, end ? 0.0 : q[j - 1]);
+            writeNumber(f, end ? 0.0 : q[j - 1 + interior]);
+            std::fputc('\n', f);
+          }
+        },
+        snapshotFile->stream());
+  }
+  Snapshots* watcher = snapshots ? &*snapshots : nullptr;
   std::fprintf(file.stream(), "# segments=%d h=%.17g k=%.17g\n", segments, string.spacing(), k);
   RunSummary summary;
   const Eigen::Index n = string.size();
@@ -164,15 +210,18 @@ int runStringCommand(const StringArguments& a) {
     InitialState start{Vector::Zero(n + 1), Vector::Zero(n + 1)};
     start.q[n] = -1e-4;  // 0.1 mm below the string
     start.p[n] = felt.mass * hammerVelocity;
-    summary = run(a.scheme, system, start, params, probeIndex, steps, every, file.stream());
+    summary =
+        run(a.scheme, system, start, params, probeIndex, steps, every, file.stream(), watcher);
   } else {
     InitialState start{Vector::Zero(n), Vector::Zero(n)};
     for (int j = 0; j < segments - 1; ++j)  // (70)
       start.q[j] = alpha * std::sqrt(physics.area) *
                    std::sin(std::numbers::pi * (j + 1) / static_cast<double>(segments));
-    summary = run(a.scheme, string, start, params, probeIndex, steps, every, file.stream());
+    summary =
+        run(a.scheme, string, start, params, probeIndex, steps, every, file.stream(), watcher);
   }
   file.commit();
+  if (snapshotFile) snapshotFile->commit();
   printSummary("string",
                a.scheme + ", " + std::to_string(segments) + " segments, k = " + a.k + " s", a.out,
                summary);

@@ -16,6 +16,7 @@ struct StringArguments {
   std::string density = "7850", area = "8.87e-7", length = "1.259", young = "2.02e11",
               tension = "759";
   std::string sigma0 = "0", sigma1 = "0";
+  std::string snapshots, snapshotOut;  // "t1,t2,..." and the CSV of the whole string at those t
   std::string out;
 };
 

@@ -10,6 +10,15 @@
 
 namespace hamiltone {
 
+// Quadrature nodes computed anew per interval in [M §4.3.1]'s count: a rule with nodes at both
+// ends of the interval (Gauss–Lobatto) needs n − 1, as its end node is the next interval's start
+// on the same continuous free flight; a Gauss–Legendre rule needs all n.
+inline long nodesPerInterval(const Quadrature& rule) {
+  for (int i = 0; i < rule.count; ++i)
+    if (rule.node[i] == 0.0) return rule.count - 1;
+  return rule.count;
+}
+
 // State at level n: q^n, p^{n−½}, p^{n+½}; reports t = n k, q^n and the pseudo-energy (13)
 //   H̃^n = V(q^n) + ½ (p^{n−½})ᵀ M⁻¹ p^{n+½}
 // (kinetic = the second term, which has no sign), and the discrete energy (17) on request.
@@ -64,6 +73,16 @@ class Marazzato {
   double discreteEnergy() const {
     return fullPotential(system_, q_, kq_) +
            0.125 * ((pPrev_ + p_).array().square() * system_.inverseMass().array()).sum();
+  }
+
+  // Force evaluations so far in [M §4.3.1]'s unit, one interaction (a term of V) at one node:
+  // steps × nodesPerInterval × interactions, the latter the system's interactionCount() if it
+  // has one, else one per coordinate.
+  long forceEvaluations() const {
+    long interactions = static_cast<long>(system_.size());
+    if constexpr (requires { system_.interactionCount(); })
+      interactions = system_.interactionCount();
+    return n_ * nodesPerInterval(quadrature_) * interactions;
   }
 
   long stepIndex() const { return n_; }

@@ -1,5 +1,7 @@
 // hamiltone-sim fpu as a user meets it: the CSV it writes, and every bad input refused with
 // exit code 2, one line naming the argument, and no output file.
+#include "support/sim_cli.h"
+
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -14,56 +16,23 @@
 
 namespace {
 
+using hamiltone::test::CliResult;
+
 namespace fs = std::filesystem;
 
-struct Result {
-  int exitCode;
-  std::string out, err;
-};
-
-class SimCli : public ::testing::Test {
+class SimCli : public hamiltone::test::SimCliTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("hamiltone-cli-" + std::to_string(::getpid()) + "-" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  Result run(const std::string& args) {
-    const std::string cmd = std::string(HAMILTONE_SIM) + " " + args + " >" +
-                            (dir_ / "stdout").string() + " 2>" + (dir_ / "stderr").string() +
-                            " </dev/null";
-    const int status = std::system(cmd.c_str());
-    Result r{WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(dir_ / "stdout"),
-             slurp(dir_ / "stderr")};
-    fs::remove(dir_ / "stdout");
-    fs::remove(dir_ / "stderr");
-    return r;
-  }
-
-  static std::string slurp(const fs::path& p) {
-    std::ifstream in(p);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-  }
-
   std::string csv() const { return (dir_ / "run.csv").string(); }
 
   // Exit 2, a single line on stderr that mentions `mention`, nothing on stdout, no file left.
   void expectRefused(const std::string& args, const std::string& mention) {
-    const Result r = run(args);
+    const CliResult r = run(args);
     EXPECT_EQ(r.exitCode, 2) << args << "\n" << r.err;
     EXPECT_NE(r.err.find(mention), std::string::npos) << args << "\nstderr: " << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
     EXPECT_TRUE(r.out.empty()) << r.out;
     EXPECT_TRUE(fs::is_empty(dir_)) << args << ": left a file behind";
   }
-
-  fs::path dir_;
 };
 
 std::vector<std::vector<double>> parseRows(const std::string& text, std::string& header) {
@@ -80,7 +49,7 @@ std::vector<std::vector<double>> parseRows(const std::string& text, std::string&
 }
 
 TEST_F(SimCli, WritesTheDocumentedCsv) {
-  const Result r =
+  const CliResult r =
       run("fpu --scheme sav-split --k 1e-3 --duration 0.01 --alpha 10 --every 3 --out " + csv());
   ASSERT_EQ(r.exitCode, 0) << r.err;
   EXPECT_NE(r.out.find("max relative energy drift (51)"), std::string::npos) << r.out;
@@ -102,12 +71,12 @@ TEST_F(SimCli, WritesTheDocumentedCsv) {
 
 TEST_F(SimCli, EverySchemeRunsAndDivergenceIsReported) {
   for (const std::string scheme : {"sv", "sav", "sav-split", "marazzato --quadrature gl5"}) {
-    const Result r = run("fpu --scheme " + scheme + " --duration 0.05 --out " + csv());
+    const CliResult r = run("fpu --scheme " + scheme + " --duration 0.05 --out " + csv());
     EXPECT_EQ(r.exitCode, 0) << scheme << ": " << r.err;
     EXPECT_TRUE(r.err.empty()) << r.err;
   }
   // Störmer–Verlet at α = 100, k = 0.02 blows up; the run stops with a warning, the file is whole.
-  const Result r = run("fpu --scheme sv --alpha 100 --k 0.02 --duration 10 --out " + csv());
+  const CliResult r = run("fpu --scheme sv --alpha 100 --k 0.02 --duration 10 --out " + csv());
   EXPECT_EQ(r.exitCode, 0);
   EXPECT_NE(r.err.find("non-finite"), std::string::npos) << r.err;
   std::string header;
@@ -118,7 +87,7 @@ TEST_F(SimCli, EverySchemeRunsAndDivergenceIsReported) {
 }
 
 TEST_F(SimCli, HelpDocumentsTheOptions) {
-  const Result r = run("fpu --help");
+  const CliResult r = run("fpu --help");
   EXPECT_EQ(r.exitCode, 0);
   for (const char* flag : {"--scheme", "--quadrature", "--k", "--duration", "--alpha", "--omega",
                            "--pairs", "--epsilon", "--sigma0", "--every", "--out", "H^{n+1/2}"})
@@ -158,7 +127,7 @@ TEST_F(SimCli, RefusesAnUnwritableOutput) {
 // The stability error comes after the output file was opened: the old file must survive it.
 TEST_F(SimCli, LeavesAnExistingFileAloneOnError) {
   { std::ofstream(csv()) << "keep\n"; }
-  const Result r = run("fpu --scheme sav-split --k 0.05 --out " + csv());
+  const CliResult r = run("fpu --scheme sav-split --k 0.05 --out " + csv());
   EXPECT_EQ(r.exitCode, 2);
   EXPECT_NE(r.err.find("(44)"), std::string::npos) << r.err;
   EXPECT_EQ(slurp(csv()), "keep\n");
@@ -177,7 +146,7 @@ TEST_F(SimCli, TimesAreExactAndTheLastStepIsWritten) {
 
 // With loss the reported drift is that of energy + dissipated, which (50) keeps constant.
 TEST_F(SimCli, LossyRunReportsTheBalanceDrift) {
-  const Result r = run("fpu --scheme sav-split --sigma0 2 --alpha 10 --out " + csv());
+  const CliResult r = run("fpu --scheme sav-split --sigma0 2 --alpha 10 --out " + csv());
   ASSERT_EQ(r.exitCode, 0) << r.err;
   const auto at = r.out.find("drift (51): ");
   ASSERT_NE(at, std::string::npos) << r.out;
@@ -217,7 +186,7 @@ TEST_F(SimCli, InterruptedRunLeavesNoFile) {
 }
 
 TEST_F(SimCli, StringWritesTheDocumentedCsv) {
-  const Result r = run("string --duration 1e-3 --every 500 --out " + csv());
+  const CliResult r = run("string --duration 1e-3 --every 500 --out " + csv());
   ASSERT_EQ(r.exitCode, 0) << r.err;
   std::istringstream text(slurp(csv()));
   std::string comment;
@@ -240,7 +209,7 @@ TEST_F(SimCli, StringWritesTheDocumentedCsv) {
 // the split scheme's on the same grid and step.
 TEST_F(SimCli, StringImplicitReferenceWritesTheSameCsv) {
   const std::string common = "string --segments 40 --k 2e-6 --alpha 300 --duration 2e-4 --every 10";
-  const Result r = run(common + " --scheme implicit --out " + csv());
+  const CliResult r = run(common + " --scheme implicit --out " + csv());
   ASSERT_EQ(r.exitCode, 0) << r.err;
   std::istringstream text(slurp(csv()));
   std::string comment;
@@ -267,7 +236,7 @@ TEST_F(SimCli, StringImplicitReferenceWritesTheSameCsv) {
 }
 
 TEST_F(SimCli, StringStrikeWithTheHammer) {
-  const Result r =
+  const CliResult r =
       run("string --grid transverse --k 2.0833333333e-5 --stiffness on --alpha 0 "
           "--hammer-velocity 3 --duration 0.05 --out " +
           csv());
@@ -295,7 +264,7 @@ TEST_F(SimCli, StringRefusesBadInput) {
 }
 
 TEST_F(SimCli, PlateWritesTheDocumentedCsv) {
-  const Result r = run("plate --duration 1e-4 --out " + csv());
+  const CliResult r = run("plate --duration 1e-4 --out " + csv());
   ASSERT_EQ(r.exitCode, 0) << r.err;
   std::istringstream text(slurp(csv()));
   std::string comment;
@@ -324,7 +293,7 @@ TEST_F(SimCli, PlateRefusesBadInput) {
 }
 
 TEST_F(SimCli, ParticleWritesTheDocumentedCsv) {
-  const Result r =
+  const CliResult r =
       run("particle --quadrature lobatto3 --k 0.01 --duration 1 --every 10 --out " + csv());
   ASSERT_EQ(r.exitCode, 0) << r.err;
   std::string header;

@@ -1,0 +1,250 @@
+// Parses the wave subcommand, runs Marazzato's scheme on the [M §3.3] string and writes the
+// energies and the midpoint's motion as CSV, and on request the string's shape at given times.
+#include "wave_command.h"
+
+#include <CLI/Validators.hpp>
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <stdexcept>
+#include <vector>
+
+#include "atomic_file.h"
+#include "csv_run.h"
+#include "models/nonlinear_wave.h"
+#include "number_arguments.h"
+#include "schemes/variable_step_marazzato.h"
+#include "usage_error.h"
+
+namespace hamiltone::cli {
+
+namespace {
+
+// Grow the step back after this many accepted steps in a row with gap <= eps_fly H̃ / 4.
+constexpr int kGrowAfter = 4;
+constexpr double kMinStepFraction = 1.0 / 1024.0;  // default --min-step: k / 2¹⁰
+
+using Scheme = VariableStepMarazzato<NonlinearWave>;
+
+// "0.1,0.5,1" → sorted times in [0, duration].
+std::vector<double> parseSnapshotTimes(const std::string& text, double duration) {
+  std::vector<double> times;
+  size_t begin = 0;
+  for (;;) {
+    const size_t comma = text.find(',', begin);
+    const std::string item = text.substr(begin, comma - begin);
+    const double t = parseReal("--snapshots", item, Range::nonNegative, "seconds");
+    if (t > duration)
+      throw UsageError("--snapshots = " + item + ": after --duration; expected times from 0 to " +
+                       formatNumber(duration) + " s");
+    times.push_back(t);
+    if (comma == std::string::npos) break;
+    begin = comma + 1;
+  }
+  std::sort(times.begin(), times.end());
+  times.erase(std::unique(times.begin(), times.end()), times.end());
+  return times;
+}
+
+// One row per node, the ends included: t,x,u1,u2.
+void writeShape(const Scheme& s, std::FILE* f) {
+  const NonlinearWave& wave = s.system();
+  const int n = wave.nodes();
+  for (int j = 0; j <= n + 1; ++j) {
+    const bool interior = j >= 1 && j <= n;
+    std::fprintf(f, "%.17g", s.time());
+    writeNumber(f, j * wave.dx());
+    writeNumber(f, interior ? s.q()[j - 1] : 0.0);
+    writeNumber(f, interior ? s.q()[n + j - 1] : 0.0);
+    std::fputc('\n', f);
+  }
+}
+
+void writeRow(const Scheme& s, std::FILE* f) {
+  const double pseudo = s.pseudoEnergy(), energy = s.discreteEnergy();
+  std::fprintf(f, "%.17g", s.time());
+  writeNumber(f, s.lastStep());
+  writeNumber(f, pseudo);
+  writeNumber(f, energy);
+  writeNumber(f, energy - pseudo);
+  writeNumber(f, s.system().displacement(s.q(), 0, 0.5));
+  writeNumber(f, s.system().displacement(s.q(), 1, 0.5));
+  std::fputc('\n', f);
+}
+
+}  // namespace
+
+CLI::App* addWaveCommand(CLI::App& app, WaveArguments& a) {
+  CLI::App* wave = app.add_subcommand(
+      "wave",
+      "Nonlinear wave equation of Marazzato et al. §3.3: an R²-valued string on [0, 1], fixed "
+      "ends, V(u1,u2) = (u1²+u2²)/2 − α(sqrt((1+u1)²+u2²) − (1+u1)), P1 elements with the "
+      "consistent mass matrix Δx tridiag(1/6, 2/3, 1/6), on Marazzato's scheme (6). Start "
+      "u(x,0) = u0 (sin πx, sin πx), ∂t u(x,0) = 0.");
+  wave->add_option("--quadrature", a.quadrature,
+                   "force quadrature of the scheme (6), (9); gl2, gl3, gl5 are Gauss–Legendre "
+                   "with 2, 3, 5 points (the paper's GL5 is gl3, its GL9 gl5), lobatto3, "
+                   "lobatto5 Gauss–Lobatto")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"midpoint", "gl2", "gl3", "gl5", "lobatto3", "lobatto5"}));
+  auto number = [&](const char* flag, std::string& value, const char* type, const char* what) {
+    addNumberOption(wave, flag, value, type, what);
+  };
+  number("--alpha", a.alpha, "NUMBER", "nonlinearity α (0 <= α < 1; 0 is the linear string)");
+  number("--amplitude", a.amplitude, "NUMBER", "u0, the amplitude of the start (> 0)");
+  number("--dx", a.dx, "NUMBER", "element width; 1/dx must be a whole number from 2 to 1e6");
+  number("--k", a.k, "SECONDS",
+         "time step (> 0); with --adaptive the first and largest step. Linear stability: "
+         "k < dx/√3");
+  number("--duration", a.duration, "SECONDS", "simulated time (> 0)");
+  number("--every", a.every, "INT", "write every N-th step (>= 1); n = 0 is always written");
+  wave->add_flag("--adaptive", a.adaptive,
+                 "adapt the step to keep ⅛[p]ᵀM⁻¹[p] <= eps_fly H̃ ([M Remark 8]; see below)");
+  number("--eps-fly", a.epsFly, "NUMBER", "the bound of --adaptive (> 0; the paper's 0.03 %)");
+  number("--min-step", a.minStep, "SECONDS",
+         "with --adaptive: the run fails rather than use a smaller step (> 0, <= k; default "
+         "k/1024)");
+  wave->add_option("--snapshots", a.snapshots,
+                   "comma-separated times (0 to --duration) at which to write the shape")
+      ->type_name("T1,T2,...");
+  wave->add_option("--snapshot-out", a.snapshotOut,
+                   "CSV file for --snapshots (needed with it): t,x,u1,u2, one row per node")
+      ->type_name("PATH");
+  addOutputOption(wave, a.out);
+  wave->footer(
+      "CSV: a header, then one row per written step n: t,h,pseudo_energy,energy,gap,u1_mid,"
+      "u2_mid.\n"
+      "  t = t^n; h = t^n − t^{n−1}, the step that reached t^n (0 at n = 0); pseudo_energy is\n"
+      "  H̃^n of (13) = V(q^n) + ½ p^{n−½}·M⁻¹p^{n+½}; energy is H^n of (17); gap = H^n − H̃^n\n"
+      "  = ⅛[p]ᵀM⁻¹[p] >= 0 (18); u1_mid, u2_mid = u(0.5, t^n).\n"
+      "Snapshots: t,x,u1,u2 at every node (ends included) at the first step at or after each\n"
+      "  requested time (the last step for a time past it).\n"
+      "--adaptive [M Remark 8]: a step whose jump [p] = p^{n+3/2} − p^{n+½} breaks\n"
+      "  ⅛[p]ᵀM⁻¹[p] <= eps_fly H̃^{n+1} is discarded and redone from the same state with half\n"
+      "  the step (H̃ is conserved for any step sequence, Theorem 1, so nothing is lost). After\n"
+      "  4 accepted steps in a row with the gap <= eps_fly H̃ / 4 the step doubles, at most to\n"
+      "  --k. A step below --min-step ends the run with exit code 1 and no file. The run stops\n"
+      "  at the last step at or before --duration.\n"
+      "Summary: 'name: value' lines: steps, rejected steps, force evaluations, the start's\n"
+      "  pseudo-energy, its max relative and absolute drift, the min and max step, and with\n"
+      "  --adaptive the max of gap / (eps_fly H̃).\n" +
+      std::string(kRunFooter));
+  return wave;
+}
+
+int runWaveCommand(const WaveArguments& a) {
+  const double alpha = parseReal("--alpha", a.alpha, Range::nonNegative);
+  if (alpha >= 1.0)
+    throw UsageError("--alpha = " + a.alpha + ": out of range; expected 0 <= alpha < 1");
+  const double amplitude = parseReal("--amplitude", a.amplitude, Range::positive);
+  const double dx = parseReal("--dx", a.dx, Range::positive);
+  const double elements = std::round(1.0 / dx);
+  if (!(elements >= 2.0 && elements <= 1e6) || std::abs(elements * dx - 1.0) > 1e-9)
+    throw UsageError("--dx = " + a.dx +
+                     ": 1/dx must be a whole number from 2 to 1000000 (e.g. 0.01, 0.005)");
+  const double k = parseReal("--k", a.k, Range::positive, "seconds");
+  const double duration = parseReal("--duration", a.duration, Range::positive, "seconds");
+  const long every = parseInteger("--every", a.every, 1);
+  const long steps = stepCount(duration, k);  // the fixed step's count; bounds the adaptive run
+  checkOutputSize(steps, every, 7);
+  AdaptiveStep adaptive{.enabled = a.adaptive, .growAfter = kGrowAfter};
+  if (a.adaptive) {
+    adaptive.epsilonFly = parseReal("--eps-fly", a.epsFly, Range::positive);
+    adaptive.minStep = a.minStep.empty()
+                           ? k * kMinStepFraction
+                           : parseReal("--min-step", a.minStep, Range::positive, "seconds");
+    if (adaptive.minStep > k)
+      throw UsageError("--min-step = " + a.minStep +
+                       ": out of range; expected at most --k = " + a.k + " s");
+  }
+  if (a.snapshots.empty() != a.snapshotOut.empty())
+    throw UsageError(a.snapshots.empty() ? "--snapshot-out needs --snapshots"
+                                         : "--snapshots needs --snapshot-out");
+  std::vector<double> snapshots;
+  if (!a.snapshots.empty()) snapshots = parseSnapshotTimes(a.snapshots, duration);
+
+  const NonlinearWave wave =
+      building([&] { return NonlinearWave(alpha, static_cast<int>(elements)); });
+  Scheme scheme = building([&] {
+    return Scheme(wave, k, nonlinearWaveInitialState(wave, amplitude),
+                  *parseQuadratureRule(a.quadrature), adaptive);
+  });
+  const double start = scheme.pseudoEnergy();
+  if (!std::isfinite(start))
+    throw UsageError("the start's pseudo-energy is " + std::to_string(start) +
+                     ": --amplitude is too large for double precision");
+
+  AtomicFile file(a.out, "--out");
+  std::unique_ptr<AtomicFile> shapes;
+  if (!snapshots.empty()) {
+    shapes = std::make_unique<AtomicFile>(a.snapshotOut, "--snapshot-out");
+    std::fprintf(shapes->stream(), "t,x,u1,u2\n");
+  }
+  std::fprintf(file.stream(), "t,h,pseudo_energy,energy,gap,u1_mid,u2_mid\n");
+
+  size_t nextSnapshot = 0;
+  long rows = 0;
+  double maxDrift = 0.0, maxGap = 0.0;
+  bool diverged = false;
+  // Times are sums of steps: a requested time is reached when within rounding of t^n.
+  const double slack = 1e-9 * k;
+  for (;;) {
+    const double t = scheme.time();
+    const double pseudo = scheme.pseudoEnergy();
+    diverged = !std::isfinite(pseudo) || !scheme.q().allFinite();
+    if (scheme.stepIndex() % every == 0 || diverged) {
+      writeRow(scheme, file.stream());
+      if (++rows % 4096 == 0 && std::ferror(file.stream()))
+        throw std::runtime_error("writing the output failed: " + std::string(std::strerror(errno)));
+    }
+    if (diverged) break;
+    maxDrift = std::max(maxDrift, std::abs(pseudo - start));
+    maxGap = std::max(maxGap, (scheme.discreteEnergy() - pseudo) / pseudo);
+    for (; nextSnapshot < snapshots.size() && snapshots[nextSnapshot] <= t + slack; ++nextSnapshot)
+      writeShape(scheme, shapes->stream());
+    const bool done =
+        a.adaptive ? t + scheme.nextStep() > duration + slack : scheme.stepIndex() == steps;
+    if (done) break;
+    if (!scheme.step())
+      throw std::runtime_error("--adaptive: at t = " + formatNumber(t) +
+                               " s the bound ⅛[p]ᵀM⁻¹[p] <= eps_fly H̃ " +
+                               "needs a step below --min-step = " + formatNumber(adaptive.minStep) +
+                               " s; no file written. Raise --eps-fly or lower --min-step");
+  }
+  if (shapes) {
+    for (; nextSnapshot < snapshots.size(); ++nextSnapshot) writeShape(scheme, shapes->stream());
+    shapes->commit();
+  }
+  file.commit();
+
+  std::printf(
+      "wave: marazzato (6), %s, alpha = %s, amplitude = %s, dx = %s (%d nodes per "
+      "direction), k = %s s%s; wrote %s (%ld rows)\n",
+      a.quadrature.c_str(), a.alpha.c_str(), a.amplitude.c_str(), a.dx.c_str(), wave.nodes(),
+      a.k.c_str(), a.adaptive ? ", adaptive" : "", a.out.c_str(), rows);
+  std::printf("steps: %ld\n", scheme.stepIndex());
+  std::printf("rejected steps: %ld\n", scheme.rejectedSteps());
+  std::printf("force evaluations: %ld\n", scheme.forceEvaluations());
+  std::printf("pseudo-energy at t = 0: %.17g\n", start);
+  std::printf("max relative pseudo-energy drift: %.6g\n", maxDrift / std::abs(start));
+  std::printf("max absolute pseudo-energy drift: %.6g\n", maxDrift);
+  std::printf("max gap / pseudo-energy: %.6g\n", maxGap);
+  if (scheme.stepIndex() > 0) {
+    std::printf("min step: %.17g\n", scheme.minStepUsed());
+    std::printf("max step: %.17g\n", scheme.maxStepUsed());
+  }
+  if (a.adaptive) std::printf("max gap / (eps_fly pseudo-energy): %.6g\n", scheme.worstGapRatio());
+  if (shapes)
+    std::printf("snapshots: wrote %s (%zu times)\n", a.snapshotOut.c_str(), snapshots.size());
+  if (diverged)
+    std::fprintf(stderr,
+                 "hamiltone-sim wave: warning: the state became non-finite at t = %.17g; the run "
+                 "stopped there, and the file ends with that row\n",
+                 scheme.time());
+  return 0;
+}
+
+}  // namespace hamiltone::cli

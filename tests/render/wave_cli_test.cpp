@@ -1,0 +1,167 @@
+// hamiltone-sim wave as a user meets it: the CSV and snapshot file it writes, a summary of
+// "name: value" lines, and every bad input refused with exit code 2, one line naming the flag.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "support/sim_cli.h"
+
+namespace {
+
+using hamiltone::test::CliResult;
+
+namespace fs = std::filesystem;
+
+class WaveCli : public hamiltone::test::SimCliTest {
+ protected:
+  CliResult run(const std::string& args) { return SimCliTest::run("wave " + args); }
+
+  // Exit 2, one line on stderr mentioning `mention`, nothing on stdout, no file left.
+  void expectRefused(const std::string& args, const std::string& mention) {
+    const CliResult r = run(args);
+    EXPECT_EQ(r.exitCode, 2) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find(mention), std::string::npos) << args << "\nstderr: " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+    EXPECT_TRUE(fs::is_empty(dir_)) << args << ": left a file behind";
+  }
+};
+
+std::vector<std::vector<double>> readCsv(const std::string& text, std::string& header) {
+  std::istringstream in(text);
+  std::getline(in, header);
+  std::vector<std::vector<double>> rows;
+  for (std::string line; std::getline(in, line);) {
+    std::vector<double> row;
+    std::istringstream cells(line);
+    for (std::string cell; std::getline(cells, cell, ',');) row.push_back(std::stod(cell));
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+TEST_F(WaveCli, WritesTheDocumentedCsvAndSummary) {
+  // 0.1 / 0.0033 → 30 steps; rows at n = 0, 5, …, 30.
+  const CliResult r =
+      run("--alpha 0.8 --amplitude 0.1 --quadrature gl3 --duration 0.1 --every 5 "
+          "--out " +
+          path("run.csv"));
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+  std::string header;
+  const auto rows = readCsv(slurp(path("run.csv")), header);
+  EXPECT_EQ(header, "t,h,pseudo_energy,energy,gap,u1_mid,u2_mid");
+  ASSERT_EQ(rows.size(), 7u);
+  EXPECT_DOUBLE_EQ(rows[0][5], 0.1);  // u(0.5, 0) = u0 sin(π/2)
+  for (size_t i = 0; i < rows.size(); ++i) {
+    ASSERT_EQ(rows[i].size(), 7u);
+    EXPECT_NEAR(rows[i][0], 0.0165 * static_cast<double>(i), 1e-15);
+    EXPECT_EQ(rows[i][1], i > 0 ? 0.0033 : 0.0);
+    EXPECT_NEAR(rows[i][2], rows[0][2], 1e-13 * rows[0][2]);  // (13) conserved (gl3)
+    EXPECT_NEAR(rows[i][4], rows[i][3] - rows[i][2], 1e-16);  // gap = H − H̃
+    EXPECT_GE(rows[i][4], 0.0);                               // (18)
+  }
+  const auto s = summary(r.out);
+  EXPECT_EQ(s.at("steps"), 30);
+  EXPECT_EQ(s.at("rejected steps"), 0);
+  EXPECT_EQ(s.at("force evaluations"), 90);
+  EXPECT_EQ(s.at("pseudo-energy at t = 0"), rows[0][2]);
+  EXPECT_LT(s.at("max relative pseudo-energy drift"), 1e-13);
+  EXPECT_LT(s.at("max absolute pseudo-energy drift"), 1e-13 * rows[0][2]);
+  EXPECT_EQ(s.at("min step"), 0.0033);
+  EXPECT_EQ(s.at("max step"), 0.0033);
+  EXPECT_EQ(s.count("max gap / (eps_fly pseudo-energy)"), 0u);
+}
+
+TEST_F(WaveCli, SnapshotsHoldEveryNodeAtTheFirstStepAtOrAfterEachTime) {
+  const CliResult r = run("--duration 0.1 --dx 0.05 --snapshots 0.05,0,0.1 --snapshot-out " +
+                          path("snap.csv") + " --out " + path("run.csv"));
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.out.find("snapshots: wrote"), std::string::npos) << r.out;
+  std::string header;
+  const auto rows = readCsv(slurp(path("snap.csv")), header);
+  EXPECT_EQ(header, "t,x,u1,u2");
+  ASSERT_EQ(rows.size(), 3u * 21u);  // 3 times × (19 interior nodes + 2 ends)
+  // 0 → t = 0; 0.05 → step 16 (0.0528); 0.1 is past the last step (30 · 0.0033 = 0.099).
+  const double times[] = {0.0, 16 * 0.0033, 30 * 0.0033};
+  for (int s = 0; s < 3; ++s)
+    for (int j = 0; j <= 20; ++j) {
+      const auto& row = rows[s * 21 + j];
+      EXPECT_NEAR(row[0], times[s], 1e-15) << s;
+      EXPECT_NEAR(row[1], 0.05 * j, 1e-15);
+      if (j == 0 || j == 20) {
+        EXPECT_EQ(row[2], 0.0);
+        EXPECT_EQ(row[3], 0.0);
+      }
+    }
+  EXPECT_DOUBLE_EQ(rows[10][2], 0.3);  // u1(0.5, 0) = u0
+}
+
+TEST_F(WaveCli, AdaptiveRunReportsItsStepsAndTheGapBound) {
+  const CliResult r = run("--adaptive --k 0.005 --duration 0.3 --out " + path("run.csv"));
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const auto s = summary(r.out);
+  EXPECT_LE(s.at("max gap / (eps_fly pseudo-energy)"), 1.0);
+  EXPECT_GT(s.at("rejected steps"), 0);
+  EXPECT_LT(s.at("min step"), 0.005);
+  EXPECT_EQ(s.at("max step"), 0.005);
+  EXPECT_EQ(s.at("force evaluations"), s.at("steps") + s.at("rejected steps"));  // midpoint
+  std::string header;
+  const auto rows = readCsv(slurp(path("run.csv")), header);
+  ASSERT_EQ(static_cast<double>(rows.size()), s.at("steps") + 1);
+  EXPECT_LE(rows.back()[0], 0.3 + 1e-12);
+  EXPECT_GT(rows.back()[0] + s.at("max step"), 0.3);
+  for (const auto& row : rows) EXPECT_LE(row[4], 3e-4 * row[2] * (1 + 1e-9));
+}
+
+TEST_F(WaveCli, AStepBelowTheMinimumEndsTheRunWithAnError) {
+  const CliResult r = run("--adaptive --eps-fly 1e-12 --min-step 0.001 --out " + path("run.csv"));
+  EXPECT_EQ(r.exitCode, 1);
+  EXPECT_NE(r.err.find("--min-step"), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::is_empty(dir_));
+}
+
+TEST_F(WaveCli, HelpDocumentsTheOptions) {
+  const CliResult r = run("--help");
+  EXPECT_EQ(r.exitCode, 0);
+  for (const char* text : {"--alpha", "--amplitude", "--quadrature", "--dx", "--k", "--duration",
+                           "--adaptive", "--eps-fly", "--min-step", "--every", "--snapshots",
+                           "--snapshot-out", "--out", "sin πx", "doubles"})
+    EXPECT_NE(r.out.find(text), std::string::npos) << text;
+}
+
+TEST_F(WaveCli, RefusesBadInput) {
+  const std::string ok = "--out " + path("run.csv");
+  expectRefused(ok + " --alpha 1", "--alpha");
+  expectRefused(ok + " --alpha -0.1", "--alpha");
+  expectRefused(ok + " --alpha x", "--alpha");
+  expectRefused(ok + " --amplitude 0", "--amplitude");
+  expectRefused(ok + " --dx 0.03", "--dx");
+  expectRefused(ok + " --dx 0.7", "--dx");
+  expectRefused(ok + " --dx 0", "--dx");
+  expectRefused(ok + " --k 0", "--k");
+  expectRefused(ok + " --k 1e-3x", "--k");
+  expectRefused(ok + " --duration -1", "--duration");
+  expectRefused(ok + " --every 0", "--every");
+  expectRefused(ok + " --quadrature simpson", "--quadrature");
+  expectRefused(ok + " --adaptive --eps-fly 0", "--eps-fly");
+  expectRefused(ok + " --adaptive --min-step 0.01", "--min-step");
+  expectRefused(ok + " --adaptive --min-step nan", "--min-step");
+  expectRefused(ok + " --snapshots 0.5", "--snapshot-out");
+  expectRefused(ok + " --snapshot-out " + path("s.csv"), "--snapshots");
+  expectRefused(ok + " --snapshots 2 --snapshot-out " + path("s.csv"), "--snapshots");
+  expectRefused(ok + " --snapshots 0.1,abc --snapshot-out " + path("s.csv"), "--snapshots");
+  expectRefused(ok + " --snapshots 0.1, --snapshot-out " + path("s.csv"), "--snapshots");
+  expectRefused("--alpha 0.5", "--out");
+}
+
+}  // namespace

@@ -1,0 +1,74 @@
+// What the hamiltone-sim command-line tests share: a scratch directory per test, the program run
+// with its output captured, and the readers of its "name: value" summary.
+#pragma once
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+
+namespace hamiltone::test {
+
+struct CliResult {
+  int exitCode;
+  std::string out, err;
+};
+
+class SimCliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("hamiltone-cli-" + std::to_string(::getpid()) + "-" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->test_suite_name() + "-" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::remove_all(dir_);
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  // `hamiltone-sim ARGS` with stdin closed; the scratch directory is left as it was.
+  CliResult run(const std::string& args) {
+    const std::string cmd = std::string(HAMILTONE_SIM) + " " + args + " >" + path("stdout") +
+                            " 2>" + path("stderr") + " </dev/null";
+    const int status = std::system(cmd.c_str());
+    CliResult r{WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(path("stdout")),
+                slurp(path("stderr"))};
+    std::filesystem::remove(path("stdout"));
+    std::filesystem::remove(path("stderr"));
+    return r;
+  }
+
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+
+  static std::string slurp(const std::filesystem::path& p) {
+    std::ifstream in(p);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  }
+
+  // The "name: value" lines of a summary whose value is one number.
+  static std::map<std::string, double> summary(const std::string& out) {
+    std::map<std::string, double> values;
+    std::istringstream lines(out);
+    for (std::string line; std::getline(lines, line);) {
+      const auto colon = line.find(": ");
+      if (colon == std::string::npos) continue;
+      char* end = nullptr;
+      const std::string value = line.substr(colon + 2);
+      const double v = std::strtod(value.c_str(), &end);
+      if (end != value.c_str() && *end == '\0') values[line.substr(0, colon)] = v;
+    }
+    return values;
+  }
+
+  std::filesystem::path dir_;
+};
+
+}  // namespace hamiltone::test
