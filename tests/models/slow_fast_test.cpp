@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include "models/inhomogeneous_wave.h"
 #include "models/slow_fast_fpu.h"
@@ -78,18 +80,25 @@ TEST(InhomogeneousWave, ExactSolutionStartsAtTheInitialDisplacement) {
       EXPECT_NEAR(waveExactDisplacement(x, 0.0, start), waveInitialDisplacement(x), 1e-17) << x;
 }
 
-// Max |u_numerical − u_exact| at time t, synchronous scheme at h = Δx/10.
-double synchronousError(double dx, double t, WaveStart start, WaveStart exactFor) {
+// Max over the nodes of |q_j − u(x_j, t)|, u the exact solution for the printed start.
+double maxError(const InhomogeneousWave& wave, const Vector& q, double t, WaveStart exactFor) {
+  double error = 0.0;
+  for (Eigen::Index j = 0; j < wave.size(); ++j)
+    error = std::max(error, std::abs(q[j] - waveExactDisplacement(wave.position(j), t, exactFor)));
+  return error;
+}
+
+// Max |u_numerical − u_exact| at time t, synchronous scheme at h = Δx/10; its force evaluations
+// in *evaluations if given.
+double synchronousError(double dx, double t, WaveStart start, WaveStart exactFor,
+                        long* evaluations = nullptr) {
   const InhomogeneousWave wave(dx);
   const double h = dx / 10.0;
   Marazzato sync(WholeSystem{wave}, StepParameters{.k = h}, waveInitialState(wave, start),
                  QuadratureRule::midpoint);
   for (long n = 0; n < std::lround(t / h); ++n) sync.step();
-  double error = 0.0;
-  for (Eigen::Index j = 0; j < wave.size(); ++j)
-    error = std::max(error, std::abs(sync.q()[j] - waveExactDisplacement(wave.position(j),
-                                                                         sync.time(), exactFor)));
-  return error;
+  if (evaluations) *evaluations = sync.forceEvaluations();
+  return maxError(wave, sync.q(), sync.time(), exactFor);
 }
 
 // At t = 0.02 (the pulse has not reached the interface) a fine run follows the exact solution for
@@ -111,6 +120,82 @@ TEST(InhomogeneousWave, SynchronousErrorFallsAtFirstOrderInForceEvaluations) {
   const double order = std::log(coarse / fine) / std::log(4.0);
   EXPECT_GE(order, 0.8);
   EXPECT_LE(order, 1.2);
+}
+
+// The asynchronous run of [M Fig. 16] at a stable ratio: N = 1/Δx intervals, h_S = r Δx,
+// h_F = h_S / K, the paper's start, midpoint rule, stepped to t = 0.5.
+struct AsynchronousRun {
+  double error;      // max |u − u_exact| at t = 0.5
+  long evaluations;  // force evaluations, [M §4.3.1]
+  double largest;    // max |q| over the coarse nodes (u⁰ peaks at 1e-2)
+};
+
+AsynchronousRun asynchronousRun(int intervals, double ratio, long k) {
+  const InhomogeneousWave wave(1.0 / intervals);
+  const double hS = ratio * wave.dx();
+  AsynchronousMarazzato async(wave, hS / static_cast<double>(k), k,
+                              waveInitialState(wave, WaveStart::paper), QuadratureRule::midpoint);
+  double largest = 0.0;
+  for (long n = 0; n < std::lround(0.5 / hS); ++n) {
+    async.step();
+    largest = std::max(largest, async.q().lpNorm<Eigen::Infinity>());
+  }
+  EXPECT_NEAR(async.time(), 0.5, 1e-12);
+  return {maxError(wave, async.q(), async.time(), WaveStart::paper), async.forceEvaluations(),
+          largest};
+}
+
+// [M Fig. 16], asynchronous. At the paper's h_S = Δx the scheme is unstable (see
+// AsynchronousMarazzato.StableBelowTheResonanceRatio): the slow particles' 2h_S-periodic mode
+// resonates with a fast mode once ω_F h_S reaches π, which no fast mode can when
+// h_S/Δx < K sin(π/(2K))/c₁ = 0.156 (K = 10). So h_S = 0.15 Δx, h_F = 0.015 Δx (inside the fast
+// CFL bound Δx/c₁), refined at fixed r and K. Measured at t = 0.5 (N = 1/Δx, evaluations):
+//   N = 1200: 3.25e-3 (2.64e7), 1500: 2.41e-3 (4.13e7)  — pre-asymptotic, local order 0.67
+//   N = 2400: 1.076e-3 (1.057e8), 3600: 4.76e-4 (2.377e8), 4800: 2.64e-4 (4.225e8)
+//   (3000: 6.89e-4, local orders 1.00, 1.02; 8000: 9.39e-5 (1.17e9), too slow for here)
+// Least-squares slope over N = 2400, 3600, 4800: −1.012 (error ∝ Δx², evaluations ∝ Δx⁻²);
+// band [−1.2, −0.8] as for the synchronous test. The error is the spatial one: the synchronous
+// run at h = Δx/10 on N = 2400 (1.088e-3) is within 2 % of it. 2.5–4 s (Release, 1 core).
+// η = async / sync evaluations: 0.550 against the synchronous scheme at the same h_F
+// (K (N/2 + 1) + N/2 − 1 springs per coarse step against K N), but 3.67 against the synchronous
+// run at its own CFL step Δx/10 for the same error, ≈ (K + 1)/(20 r): below the resonance ratio
+// the asynchronous scheme saves nothing on this problem.
+TEST(InhomogeneousWave, AsynchronousErrorFallsAtFirstOrderInForceEvaluations) {
+  constexpr double ratio = 0.15;  // h_S / Δx; N divisible by 3 makes 0.5/h_S = 10N/3 an integer
+  constexpr long k = 10;
+  ASSERT_LT(ratio, k * std::sin(M_PI / (2.0 * k)) / InhomogeneousWave::kFastSpeed);
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  const std::vector<int> grids = {2400, 3600, 4800};
+  std::vector<AsynchronousRun> runs;
+  for (int n : grids) {
+    runs.push_back(asynchronousRun(n, ratio, k));
+    const AsynchronousRun& r = runs.back();
+    ASSERT_TRUE(std::isfinite(r.error)) << n;
+    EXPECT_LT(r.largest, 1.1e-2) << n;  // stable: no growth past the start's amplitude
+    EXPECT_LT(r.error, 2e-3) << n;
+    const long springsPerCoarseStep = k * (n / 2 + 1) + n / 2 - 1;
+    EXPECT_EQ(r.evaluations, std::lround(10.0 * n / 3.0) * springsPerCoarseStep) << n;
+    const double x = std::log(static_cast<double>(r.evaluations)), y = std::log(r.error);
+    sx += x, sy += y, sxx += x * x, sxy += x * y;
+  }
+  const double count = static_cast<double>(grids.size());
+  const double slope = (count * sxy - sx * sy) / (count * sxx - sx * sx);
+  EXPECT_GE(slope, -1.2);
+  EXPECT_LE(slope, -0.8);
+  // η against the synchronous scheme at h_F, from the counts per coarse step (0.5504 at N = 2400).
+  const int n0 = grids.front();
+  const double etaSameStep = static_cast<double>(k * (n0 / 2 + 1) + n0 / 2 - 1) / (k * n0);
+  EXPECT_NEAR(etaSameStep, 0.5504, 1e-4);
+  // Against the synchronous run at Δx/10 on the same grid: the same error, 3.67 times the count.
+  long syncEvaluations = 0;
+  const double syncError =
+      synchronousError(1.0 / n0, 0.5, WaveStart::paper, WaveStart::paper, &syncEvaluations);
+  EXPECT_NEAR(runs.front().error / syncError, 1.0, 0.05);
+  const double etaAtCfl = static_cast<double>(runs.front().evaluations) / syncEvaluations;
+  EXPECT_NEAR(etaAtCfl, (k + 1) / (20.0 * ratio), 0.01);
+  RecordProperty("slope", std::to_string(slope));
+  RecordProperty("eta_same_step", std::to_string(etaSameStep));
+  RecordProperty("eta_at_cfl", std::to_string(etaAtCfl));
 }
 
 // The asynchronous scheme's count per coarse step is K (N/2 + 1) + N/2 − 1 springs against the

@@ -159,5 +159,30 @@ TEST(AsynchronousMarazzato, ResonanceOfTheSlowStepWithAFastMode) {
   EXPECT_GT(growth(0.125), 100.0);
 }
 
+// The same resonance on [M §4.3.2]'s problem. A fast mode of frequency ω (at most 2c₁/Δx) turns
+// by θ per fine step, sin(θ/2) = ω h_F/2, so by Kθ per coarse step; Kθ = π needs
+// h_S/Δx >= K sin(π/(2K))/c₁ (0.156 at K = 10, c₁ = 10). On N = 250, paper start, K = 10:
+// at the paper's h_S = Δx, max |q| (1e-2 at the start) is 190 by t = 1; at h_S = 0.15 Δx it stays
+// at 1.047e-2 to t = 8. (Whether h_S = Δx blows up depends on a discrete mode lying close to the
+// resonance: N = 500 stays below 2.1e-2 to t = 8, N = 2000 reaches 7.3e3 by t = 0.5.)
+double waveLargest(double ratio, double duration) {
+  const InhomogeneousWave wave(4e-3);
+  const double hS = ratio * wave.dx();
+  AsynchronousMarazzato async(wave, hS / 10, 10, waveInitialState(wave, WaveStart::paper),
+                              QuadratureRule::midpoint);
+  double largest = 0.0;
+  for (long n = 0; n < std::lround(duration / hS); ++n) {
+    async.step();
+    largest = std::max(largest, async.q().lpNorm<Eigen::Infinity>());
+  }
+  return largest;
+}
+
+TEST(AsynchronousMarazzato, StableBelowTheResonanceRatio) {
+  EXPECT_LT(0.15, 10 * std::sin(M_PI / 20.0) / InhomogeneousWave::kFastSpeed);
+  EXPECT_GT(waveLargest(1.0, 1.0), 1.0);
+  EXPECT_LT(waveLargest(0.15, 8.0), 1.1e-2);
+}
+
 }  // namespace
 }  // namespace hamiltone
