@@ -15,6 +15,7 @@ packages=(
   clang-22 libclang-rt-22-dev llvm-22  # tests/rtsan: RTSan test (bookworm-security; llvm-22 symbolises)
   libbenchmark-dev    # bench/
   jackd2              # tests/e2e: a JACK server (dummy driver) for hamiltone-play's test
+  python3-matplotlib python3-numpy  # scripts/validation.sh: the figures of docs/validation.md (Debian's, run by /usr/bin/python3)
 )
 
 missing=()
