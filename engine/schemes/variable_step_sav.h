@@ -37,6 +37,7 @@ class VariableStepSav {
     p_ = start.p;
     grad_.setZero(n);
     kq_.setZero(n);
+    half_.setZero(n);
     startPotential_ = fullPotential(system_, q_, kq_);
   }
 
@@ -56,9 +57,12 @@ class VariableStepSav {
     time_ += k;
     ++n_;
     if (n_ == 1) {
-      // ψ^{½} = sqrt(2 (V(q^{½}) + ε)), q^{½} = (q^0 + q^1)/2: second order, like (32).
-      grad_ = q_ - (0.5 * k) * system_.inverseMass().cwiseProduct(p_);  // workspace
-      psi_ = std::sqrt(2.0 * (fullPotential(system_, grad_, kq_) + epsilon_));
+      // ψ^{½} = sqrt(2 (V(q^{½}) + ε)) at q^{½} = q(k/2) + O(k³) = q^0 + (k/2) M⁻¹p^{½} +
+      // (k²/8) M⁻¹∇V(q^0), grad_ still holding ∇V(q^0); the mean (q^0 + q^1)/2 would be O(k²)
+      // off, an error the conserved energy keeps (see SavScheme's start).
+      half_ = q_ - (0.5 * k) * system_.inverseMass().cwiseProduct(p_) +
+              (0.125 * k * k) * system_.inverseMass().cwiseProduct(grad_);
+      psi_ = std::sqrt(2.0 * (fullPotential(system_, half_, kq_) + epsilon_));
     }
   }
 
@@ -105,6 +109,7 @@ class VariableStepSav {
   Vector q_, p_;                 // q^n, p^{n−½}
   Vector grad_;                  // ∇V at q^n; workspace
   Vector kq_;                    // K q, the scratch of fullPotential / fullGradient
+  Vector half_;                  // q^{½}, where the first ψ is taken
   double startPotential_ = 0.0;  // V(q(0))
   double psi_ = 0.0;             // ψ^{n−½}
   double lastStep_ = 0.0;

@@ -24,9 +24,11 @@ void expectConservesEnergy(double alpha) {
   EXPECT_LE(maxRelativeDeviation(h), 1e-12) << "alpha " << alpha;
 }
 
-// The conserved H^{½} is the physical H(0) to second order, from a start with momentum in every
-// coordinate and unequal masses: the start (21) and ψ^{½} are both O(k²) accurate, so the gap
-// falls fourfold per halving (a first-order ψ^{½}, sqrt(2V'(q^0)), would only halve it).
+// The conserved H^{½} is the physical H(0) to at least second order, from a start with momentum
+// in every coordinate and unequal masses: the start (21) is O(k²) accurate and ψ^{½} is taken at
+// q(k/2) + O(k³), so the gap falls at least fourfold per halving (measured 3.97–4.00, and 13.4 for
+// (27) at α = 100, where its k² terms nearly cancel); a first-order ψ^{½}, sqrt(2V'(q^0)), would
+// only halve it.
 template <template <class> class Scheme>
 void expectStartsAtThePhysicalEnergy(double alpha) {
   const testing::WeightedChain system;
@@ -36,7 +38,7 @@ void expectStartsAtThePhysicalEnergy(double alpha) {
     return std::abs(Scheme<testing::WeightedChain>(system, {.k = k}, start).energy().total() -
                     exact);
   };
-  EXPECT_NEAR(gap(1e-4) / gap(5e-5), 4.0, 0.2) << "alpha " << alpha;
+  EXPECT_GE(gap(1e-4) / gap(5e-5), 3.8) << "alpha " << alpha;
   EXPECT_LT(gap(1e-4), 1e-3 * exact);
 }
 
