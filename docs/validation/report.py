@@ -53,7 +53,10 @@ def commit(source):
         done = subprocess.run(["git", "-C", source, *args], capture_output=True, text=True)
         return done.stdout.strip() if done.returncode == 0 else ""
     head = git("rev-parse", "--short=12", "HEAD") or "unknown"
-    return head + (" (with uncommitted changes)" if git("status", "--porcelain", "--untracked-files=no") else "")
+    # The report's own outputs (rewritten by this run) do not count as changes to the code.
+    changed = git("status", "--porcelain", "--untracked-files=no", "--", ".",
+                  ":(exclude)docs/validation.md", ":(exclude)docs/figures")
+    return head + (" (with uncommitted changes)" if changed else "")
 
 
 def main():
