@@ -9,21 +9,29 @@
 #   Release tree build/release, like scripts/demo.sh.
 # Exit 77 (ctest's skip code) with --build-dir when Debian's python3-matplotlib is missing.
 set -euo pipefail
-cd "$(dirname "$0")/.."
 
+usage() { echo "validation.sh: $1 (usage: validation.sh [--quick] [--out DIR] [--build-dir DIR])" >&2; exit 2; }
 quick=()
-out=docs
+out=
 build_dir=
 while [ $# -gt 0 ]; do
   case "$1" in
     --quick) quick=(--quick) ;;
-    --out) out="${2:?--out needs a directory}"; shift ;;
-    --build-dir) build_dir="${2:?--build-dir needs a directory}"; shift ;;
-    *) echo "validation.sh: unknown argument '$1' (expected --quick, --out DIR, --build-dir DIR)" >&2
-       exit 2 ;;
+    --out) [ -n "${2:-}" ] || usage "--out needs a directory"; out="$2"; shift ;;
+    --build-dir) [ -n "${2:-}" ] || usage "--build-dir needs a directory"; build_dir="$2"; shift ;;
+    *) usage "unknown argument '$1'" ;;
   esac
   shift
 done
+# Paths given on the command line are the caller's: make them absolute before moving to the root.
+case "$out" in /* | "") ;; *) out="$PWD/$out" ;; esac
+if [ -n "$build_dir" ]; then
+  case "$build_dir" in /*) ;; *) build_dir="$PWD/$build_dir" ;; esac
+  [ -d "$build_dir" ] || usage "--build-dir $build_dir: no such directory"
+fi
+cd "$(dirname "$0")/.."
+out=${out:-docs}
+mkdir -p "$out" 2>/dev/null && [ -w "$out" ] || usage "--out $out: cannot create or write to it"
 
 # Debian's interpreter, not a pyenv one that lacks matplotlib.
 python=/usr/bin/python3
@@ -45,12 +53,19 @@ for b in "$sim" "$render"; do
   [ -x "$b" ] || { echo "validation.sh: $b is not built" >&2; exit 1; }
 done
 
-mkdir -p "$out/figures"
-rm -f "$out"/figures/*.png
+# The report is written to a fresh directory beside the old one and replaces it only when the run
+# has finished, so an interrupted run leaves the previous report and its figures intact.
+work=$(mktemp -d "$out/.validation-XXXXXX")
+trap 'rm -rf "$work"' EXIT
 start=$SECONDS
 status=0
-"$python" docs/validation/report.py --sim "$sim" --render "$render" --out "$out" "${quick[@]}" ||
+"$python" docs/validation/report.py --sim "$sim" --render "$render" --out "$work" "${quick[@]}" ||
   status=$?
+[ -f "$work/validation.md" ] || { echo "validation.sh: the report was not written" >&2; exit 1; }
+mkdir -p "$out/figures"
+rm -f "$out"/figures/*.png
+mv "$work"/figures/*.png "$out/figures/" 2>/dev/null || true
+mv "$work/validation.md" "$out/validation.md"
 
 # Every figure the report links exists, and every figure written is linked.
 for f in $(grep -o '](figures/[^)]*\.png)' "$out/validation.md" | sed 's/^](//; s/)$//'); do
