@@ -5,20 +5,20 @@
 
 namespace hamiltone::cli {
 
-long stepCount(double duration, double k) {
+long stepCount(double duration, double k, const std::string& ratio) {
   const double steps = std::floor(duration / k * (1.0 + 1e-12));
-  if (!(steps >= 1.0) || steps > 1e10)
-    throw UsageError("--duration / --k = " + std::to_string(duration / k) +
+  if (!(steps >= 1.0) || steps > kMaxSteps)
+    throw UsageError(ratio + " = " + std::to_string(duration / k) +
                      " steps: expected between 1 and 1e10");
   return static_cast<long>(steps);
 }
 
-void checkOutputSize(long steps, long every, long columns) {
+void checkOutputSize(long steps, long every, long columns, const std::string& remedy) {
   const double numbers = (static_cast<double>(steps / every) + 1.0) * static_cast<double>(columns);
   if (numbers > 2e8)
     throw UsageError("the CSV would hold " + std::to_string(static_cast<long long>(numbers)) +
                      " numbers (" + std::to_string(static_cast<long long>(numbers * 2.4e-8)) +
-                     " GB): expected at most 2e8; raise --every or shorten --duration");
+                     " GB): expected at most 2e8; " + remedy);
 }
 
 void printSummary(const std::string& command, const std::string& what, const std::string& path,

@@ -80,11 +80,15 @@ auto building(Make make) {
   }
 }
 
-// floor(duration / k) steps, refused outside 1 … 1e10.
-long stepCount(double duration, double k);
+// The most steps a run may take (of its finest step, where it has several).
+inline constexpr double kMaxSteps = 1e10;
 
-// Refuses a CSV of more than 2e8 numbers (a few GB): names --every and --duration.
-void checkOutputSize(long steps, long every, long columns);
+// floor(duration / k) steps, refused outside 1 … 1e10; `ratio` names the flags of duration / k.
+long stepCount(double duration, double k, const std::string& ratio = "--duration / --k");
+
+// Refuses a CSV of more than 2e8 numbers (a few GB); `remedy` says which flags to change.
+void checkOutputSize(long steps, long every, long columns,
+                     const std::string& remedy = "raise --every or shorten --duration");
 
 // The lines a run prints on stdout (and its divergence warning on stderr).
 void printSummary(const std::string& command, const std::string& what, const std::string& path,

@@ -29,6 +29,7 @@ CLI::App* addFpuCommand(CLI::App& app, FpuArguments& a) {
                   "sv: Störmer–Verlet (20); sav: explicit SAV (27); sav-split: split-potential "
                   "SAV (38), needs k <= 2/ω (54); marazzato: Marazzato et al. (22)")
       ->check(CLI::IsMember({"sv", "sav", "sav-split", "marazzato"}));
+  a.command = fpu;
   fpu->add_flag("--slow-fast", a.slowFast,
                 "the slow/fast chain of [M §4.3.1] (m linear springs, then m + 1 quartic ones) on "
                 "the asynchronous scheme [M (21)–(25)], steps --hs and --hf; replaces --scheme");
@@ -49,8 +50,10 @@ CLI::App* addFpuCommand(CLI::App& app, FpuArguments& a) {
   number("--omega", a.omega, "RAD/S",
          "linear spring frequency ω (> 0; default 50, with --slow-fast √10: ω² = 10)");
   number("--pairs", a.pairs, "INT",
-         "number of pairs M (>= 2; N = 2M masses); with --slow-fast the paper's m (>= 2)");
-  number("--hs", a.hs, "SECONDS", "--slow-fast: coarse step h_S, an integer multiple K of --hf");
+         "number of pairs M (2 … 1e6; N = 2M masses, a CSV row of 2M + 4 numbers); with "
+         "--slow-fast the paper's m (2 … 1e6)");
+  number("--hs", a.hs, "SECONDS",
+         "--slow-fast: coarse step h_S, an integer multiple K (1 … 1e9) of --hf");
   number("--hf", a.hf, "SECONDS", "--slow-fast: fine step h_F (> 0), within the CFL bound (16)");
   number("--epsilon", a.epsilon, "JOULES", "gauge shift ε of sav, sav-split, §2.5 (>= 0)");
   number("--sigma0", a.sigma0, "1/S",
@@ -67,7 +70,9 @@ CLI::App* addFpuCommand(CLI::App& app, FpuArguments& a) {
       "--slow-fast: rows at the coarse nodes t = n h_S (--sync: t = n h_F), energy = the\n"
       "  pseudo-energy (26) [(13) with --sync]; the start is q(0) = α e_{m+1}, p(0) = 0. The\n"
       "  summary adds the counted force evaluations (one spring at one new quadrature node)\n"
-      "  and [M §4.3.1]'s N_s, N_a and η = N_a / N_s for the same run.\n" +
+      "  and [M §4.3.1]'s N_s, N_a and η = N_a / N_s for the same run. At most 1e10 steps of\n"
+      "  h_F (duration/h_S × K) and 1e12 particle steps (h_F steps of the m fast and mixed\n"
+      "  particles, h_S steps of the m slow ones; all 2m at h_F with --sync).\n" +
       std::string(kRunFooter));
   return fpu;
 }
@@ -105,25 +110,46 @@ RunSummary simulate(Scheme scheme, const FpuRun& run, std::FILE* out) {
   return simulate(scheme, run.chain.size(), run.steps, run.every, out);
 }
 
+// Whether `flag` was on the command line, whatever its text (an empty one included).
+bool given(const FpuArguments& a, const char* flag) {
+  return a.command != nullptr && a.command->count(flag) > 0;
+}
+
+// ω, or `fallback` when --omega is not given; refused where ω² is not a positive finite double
+// (the springs' stiffness ω²/2 and every bound derived from it would be 0, inf or NaN).
+double parseOmega(const FpuArguments& a, double fallback) {
+  if (!given(a, "--omega")) return fallback;
+  const double omega = parseReal("--omega", a.omega, Range::positive, "rad/s");
+  const double square = omega * omega;
+  if (!std::isfinite(square) || square == 0.0)
+    throw UsageError("--omega = " + a.omega +
+                     ": ω² must be a finite number > 0 in double precision; expected ω from "
+                     "about 1e-154 to 1e154 rad/s");
+  return omega;
+}
+
 // `fpu --slow-fast`: [M §4.3.1] on AsynchronousMarazzato, or Marazzato at h_F with --sync.
 int runSlowFast(const FpuArguments& a) {
   if (!a.scheme.empty())
     throw UsageError("--scheme = " + a.scheme +
                      ": --slow-fast runs its own schemes; drop --scheme");
-  if (a.k != "1e-3") throw UsageError("--k = " + a.k + ": with --slow-fast use --hs and --hf");
-  if (a.epsilon != "0" || a.sigma0 != "0")
+  if (given(a, "--k")) throw UsageError("--k = " + a.k + ": with --slow-fast use --hs and --hf");
+  if (given(a, "--epsilon") || given(a, "--sigma0"))
     throw UsageError("--epsilon / --sigma0: not used by --slow-fast (lossless, no SAV)");
   const double hs = parseReal("--hs", a.hs, Range::positive, "seconds");
   const double hf = parseReal("--hf", a.hf, Range::positive, "seconds");
   const double duration = parseReal("--duration", a.duration, Range::positive, "seconds");
   const double alpha = parseReal("--alpha", a.alpha, Range::any);
-  const double omega =
-      a.omega.empty() ? std::sqrt(10.0) : parseReal("--omega", a.omega, Range::positive, "rad/s");
+  const double omega = parseOmega(a, std::sqrt(10.0));
   const long pairs = parseInteger("--pairs", a.pairs, 2, 1'000'000);
   const long every = parseInteger("--every", a.every, 1);
-  const double ratio = std::round(hs / hf);
-  if (ratio < 1.0 || ratio > 1e9 || std::abs(hs / hf - ratio) > 1e-9 * ratio)
-    throw UsageError("--hs / --hf = " + formatNumber(hs / hf) +
+  const double quotient = hs / hf;
+  if (!(quotient <= 1e9 + 0.5))
+    throw UsageError("--hs / --hf = " + formatNumber(quotient) +
+                     ": K = h_S / h_F must be at most 1e9");
+  const double ratio = std::round(quotient);
+  if (ratio < 1.0 || std::abs(quotient - ratio) > 1e-9 * ratio)
+    throw UsageError("--hs / --hf = " + formatNumber(quotient) +
                      ": h_S must be an integer multiple K >= 1 of h_F");
   const long k = static_cast<long>(ratio);
   const QuadratureRule rule =
@@ -134,7 +160,21 @@ int runSlowFast(const FpuArguments& a) {
   if (hf >= bound)
     throw UsageError("--hf = " + a.hf + ": the CFL bound (16) of the linear springs is h_F < " +
                      formatNumber(bound) + " s");
-  const long coarseSteps = stepCount(duration, hs);
+  const long coarseSteps = stepCount(duration, hs, "--duration / --hs");
+  // Both schemes take K steps of h_F per coarse step: count them (and the particle steps) in
+  // double, where they cannot overflow, before any is taken.
+  const double fineSteps = static_cast<double>(coarseSteps) * ratio;
+  if (fineSteps > kMaxSteps)
+    throw UsageError("--duration / --hf = " + formatNumber(fineSteps) +
+                     " steps of h_F (K = --hs / --hf = " + std::to_string(k) +
+                     " per coarse step): expected at most 1e10; shorten --duration or raise --hf");
+  const double m = static_cast<double>(pairs);
+  const double particleSteps = a.sync ? fineSteps * 2.0 * m : fineSteps * m + coarseSteps * m;
+  if (particleSteps > 1e12)
+    throw UsageError("--pairs = " + a.pairs + ", --duration = " + a.duration +
+                     ", --hs / --hf = " + std::to_string(k) + ": " + formatNumber(particleSteps) +
+                     " particle steps, expected at most 1e12; lower --pairs, shorten --duration "
+                     "or raise --hf");
   const long steps = a.sync ? coarseSteps * k : coarseSteps;
   checkOutputSize(steps, every, 2 * pairs + 4);
   const InitialState start = building([&] { return slowFastInitialState(chain, alpha); });
@@ -160,7 +200,7 @@ int runSlowFast(const FpuArguments& a) {
                a.out, summary);
   // [M §4.3.1]: N_s = (n−1) T (2m+1)/h_F, N_a = (n−1) T ((m+1)/h_F + m/h_S), T = the run's.
   const double nodes = static_cast<double>(nodesPerInterval(quadrature(rule)));
-  const double t = static_cast<double>(coarseSteps) * hs, m = static_cast<double>(pairs);
+  const double t = static_cast<double>(coarseSteps) * hs;
   const double ns = nodes * t * (2.0 * m + 1.0) / hf, na = nodes * t * ((m + 1.0) / hf + m / hs);
   std::printf("force evaluations: %ld\n", evaluations);
   std::printf("paper N_s: %.17g\npaper N_a: %.17g\n", ns, na);
@@ -177,10 +217,9 @@ int runFpuCommand(const FpuArguments& a) {
   const double k = parseReal("--k", a.k, Range::positive, "seconds");
   const double duration = parseReal("--duration", a.duration, Range::positive, "seconds");
   const double alpha = parseReal("--alpha", a.alpha, Range::any);
-  const double omega =
-      a.omega.empty() ? 50.0 : parseReal("--omega", a.omega, Range::positive, "rad/s");
+  const double omega = parseOmega(a, 50.0);
   const long pairs = parseInteger("--pairs", a.pairs, 2, 1'000'000);
-  if (a.hs != "1e-2" || a.hf != "2e-4")
+  if (given(a, "--hs") || given(a, "--hf"))
     throw UsageError("--hs / --hf: apply to --slow-fast only; use --k");
   const double epsilon = parseReal("--epsilon", a.epsilon, Range::nonNegative, "J");
   const double sigma0 = parseReal("--sigma0", a.sigma0, Range::nonNegative, "1/s");

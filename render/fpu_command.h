@@ -16,6 +16,8 @@ struct FpuArguments {
   // --slow-fast: the chain of [M §4.3.1] on the asynchronous scheme (or --sync: synchronous).
   bool slowFast = false, sync = false;
   std::string hs = "1e-2", hf = "2e-4";
+  // Set by addFpuCommand: its options' counts tell which flags were given (whatever the text).
+  const CLI::App* command = nullptr;
 };
 
 // Registers the subcommand and its options on `app`; the returned pointer tells if it was chosen.

@@ -4,6 +4,8 @@
 #include <CLI/Validators.hpp>
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
+#include <string>
 
 #include "atomic_file.h"
 #include "csv_run.h"
@@ -25,7 +27,8 @@ CLI::App* addWaveInhomogeneousCommand(CLI::App& app, WaveInhomogeneousArguments&
   auto number = [&](const char* flag, std::string& value, const char* type, const char* what) {
     addNumberOption(wave, flag, value, type, what);
   };
-  number("--dx", a.dx, "METRES", "grid step Δx, 1/Δx an even integer (the interface is a node)");
+  number("--dx", a.dx, "METRES",
+         "grid step Δx, 1/Δx an even integer from 4 to 1e7 (the interface is a node)");
   number("--ratio", a.ratio, "INT",
          "K = h_S/h_F (>= 10: the CFL bound (16) of the fast part is h_F <= Δx/10)");
   number("--duration", a.duration, "SECONDS",
@@ -46,7 +49,9 @@ CLI::App* addWaveInhomogeneousCommand(CLI::App& app, WaveInhomogeneousArguments&
       "Summary (name: value lines): time, max displacement error (L∞ at the end), force\n"
       "  evaluations (one spring at one new quadrature node, [M §4.3.1]'s unit), pseudo-energy\n"
       "  drift (max |H̃^n − H̃^0| / H̃^0 over the coarse nodes, (26) or (13) with --sync).\n"
-      "Steps: floor(duration / h_S) coarse steps (K times as many with --sync).\n"
+      "Steps: floor(duration / h_S) coarse steps, K steps of h_F each; at most 1e10 steps of h_F\n"
+      "  and 1e12 particle steps. A state that becomes non-finite ends the run there, with a\n"
+      "  warning; the file then holds that state.\n"
       "Exit codes: 0 done, 1 an I/O error (no file is left), 2 bad input.");
   return wave;
 }
@@ -58,23 +63,39 @@ struct WaveResult {
   long evaluations = 0;
   Vector q;
   double time = 0.0;
+  bool diverged = false;  // a non-finite state ended the run early
 };
 
-// Steps `steps` times, recording the pseudo-energy drift every `every` steps (the coarse nodes).
+// Steps `steps` times, recording the pseudo-energy drift every `every` steps (the coarse nodes),
+// and stops at the first non-finite state (q or the pseudo-energy), which is then the result.
 template <class Scheme>
 WaveResult run(Scheme& scheme, long steps, long every) {
   WaveResult r;
   const double h0 = scheme.energy().total();
   for (long n = 1; n <= steps; ++n) {
     scheme.step();
-    if (n % every == 0)
-      r.drift = std::max(r.drift, std::abs(scheme.energy().total() - h0) / std::abs(h0));
+    if (!scheme.q().allFinite()) {
+      r.diverged = true;
+      break;
+    }
+    if (n % every == 0) {
+      const double h = scheme.energy().total();
+      if (!std::isfinite(h)) {
+        r.diverged = true;
+        break;
+      }
+      r.drift = std::max(r.drift, std::abs(h - h0) / std::abs(h0));
+    }
   }
   r.evaluations = scheme.forceEvaluations();
   r.q = scheme.q();
   r.time = scheme.time();
   return r;
 }
+
+// The most intervals N = 1/Δx: the scheme keeps about a dozen vectors of N doubles (1e7: about
+// 1 GB), and the CSV has N + 1 rows of 3 numbers.
+constexpr double kMaxIntervals = 1e7;
 
 }  // namespace
 
@@ -86,14 +107,31 @@ int runWaveInhomogeneousCommand(const WaveInhomogeneousArguments& a) {
     throw UsageError("--duration = " + a.duration +
                      ": expected <= 0.5 s; later the transmitted wave meets the wall at x = 1, "
                      "which the exact solution of [M §4.3.2] leaves out");
-  const InhomogeneousWave wave = building([&] { return InhomogeneousWave(dx); });
+  // Output and memory before the model is built: N + 1 rows of 3 numbers, N − 1 particles.
+  const double intervals = std::round(1.0 / dx);
+  if (!(intervals <= kMaxIntervals))
+    throw UsageError("--dx = " + a.dx + ": 1/dx = " + formatNumber(1.0 / dx) +
+                     " intervals, expected at most 1e7 (memory and CSV size); use --dx >= 1e-7");
+  checkOutputSize(static_cast<long>(intervals), 1, 3, "raise --dx");
+  const InhomogeneousWave wave = building([&] {
+    try {
+      return InhomogeneousWave(dx);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument("--" + std::string(e.what()));  // "dx = …" names the flag
+    }
+  });
   const double hs = dx, hf = dx / static_cast<double>(ratio);
   if (hf > wave.fastStepBound() * (1.0 + 1e-12))
     throw UsageError("--ratio = " + a.ratio + ": h_F = Δx/K = " + formatNumber(hf) +
                      " s breaks the CFL bound (16) of the fast part, h_F <= Δx/c₁ = " +
                      formatNumber(wave.fastStepBound()) + " s; use --ratio >= 10");
-  const long coarseSteps = stepCount(duration, hs);
-  if (static_cast<double>(coarseSteps) * static_cast<double>(ratio) * wave.size() > 1e12)
+  const long coarseSteps = stepCount(duration, hs, "--duration / --dx (h_S = Δx)");
+  const double fineSteps = static_cast<double>(coarseSteps) * static_cast<double>(ratio);
+  if (fineSteps > kMaxSteps)
+    throw UsageError("--duration / --dx × --ratio = " + formatNumber(fineSteps) +
+                     " steps of h_F: expected at most 1e10; coarsen --dx, lower --ratio or "
+                     "shorten --duration");
+  if (fineSteps * static_cast<double>(wave.size()) > 1e12)
     throw UsageError("--dx = " + a.dx + ", --ratio = " + a.ratio +
                      ": over 1e12 particle steps; coarsen --dx or shorten --duration");
   const WaveStart start = a.start == "paper" ? WaveStart::paper : WaveStart::rightGoing;
@@ -129,7 +167,13 @@ int runWaveInhomogeneousCommand(const WaveInhomogeneousArguments& a) {
   std::printf("max displacement error: %.6e\n", error);
   std::printf("force evaluations: %ld\n", r.evaluations);
   std::printf("pseudo-energy drift: %.3e\n", r.drift);
-  if (!std::isfinite(error) || error > 0.1)
+  if (r.diverged)
+    std::fprintf(stderr,
+                 "hamiltone-sim wave-inhomogeneous: warning: the state became non-finite at "
+                 "t = %.17g; the run stopped there, and the file holds that state (see the "
+                 "README on the asynchronous scheme's instability; --sync is stable)\n",
+                 r.time);
+  else if (!std::isfinite(error) || error > 0.1)
     std::fprintf(stderr,
                  "hamiltone-sim wave-inhomogeneous: warning: the error exceeds the pulse's size; "
                  "the asynchronous scheme is unstable here (a resonance of its slow particles' "

@@ -1,8 +1,8 @@
 // The slow/fast FPU chain's three potentials V_F, V_M, V_S and their gradients, [M §4.3.1].
 #include "models/slow_fast_fpu.h"
 
-#include <Eigen/Eigenvalues>
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 
@@ -85,16 +85,15 @@ void SlowFastFermiPastaUlam::addSlowGradient(const Vector& q, double w, Vector& 
 }
 
 double SlowFastFermiPastaUlam::fastEigenvalueMax() const {
-  // κ × the m×m matrix of wall–q_1–…–q_m with q_m free on the right: tridiag(−1, 2, −1) with a
-  // last diagonal entry 1 (the quartic spring has no linear stiffness at rest).
-  const int m = pairs_;
-  Eigen::MatrixXd k = Eigen::MatrixXd::Zero(m, m);
-  for (int i = 0; i < m; ++i) {
-    k(i, i) = (i == m - 1) ? 1.0 : 2.0;
-    if (i > 0) k(i, i - 1) = k(i - 1, i) = -1.0;
-  }
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(k, Eigen::EigenvaluesOnly);
-  return 0.5 * omega_ * omega_ * solver.eigenvalues().maxCoeff();
+  // κ = ω²/2 times the m×m stiffness of wall–q_1–…–q_m with q_m free on the right (the quartic
+  // spring has no linear stiffness at rest): tridiag(−1, 2, −1) with a last diagonal entry 1.
+  // v_i = sin(iθ) (v_0 = 0 at the wall) solves the rows i < m with λ = 2 − 2cos θ = 4 sin²(θ/2);
+  // the last row −v_{m−1} + v_m = λ v_m is that same row with a ghost v_{m+1} = v_m, so
+  // sin((m+1)θ) = sin(mθ): θ_j = (2j − 1)π/(2m + 1), j = 1 … m, and
+  // λ_j = 4 sin²((2j − 1)π/(2(2m + 1))), the largest at j = m. O(1), no dense solve.
+  const double m = static_cast<double>(pairs_);
+  const double s = std::sin((2.0 * m - 1.0) * std::numbers::pi / (2.0 * (2.0 * m + 1.0)));
+  return 0.5 * omega_ * omega_ * 4.0 * s * s;
 }
 
 double SlowFastFermiPastaUlam::potential(const Vector& q) const {

@@ -2,6 +2,7 @@
 // springs, exact solution and [M Fig. 16] convergence.
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -49,6 +50,28 @@ TEST(SlowFastFermiPastaUlam, SplitAndPartitionFollowThePaper) {
       [](const C& c, const Vector& x, Vector& g) { c.addSlowGradient(x, 1.0, g); });
   // λmax of 5 × tridiag with a free end: 5 (2 − 2 cos(5π/7)) = 16.23, so h_F < 0.496 s.
   EXPECT_NEAR(chain.fastEigenvalueMax(), 5.0 * (2.0 - 2.0 * std::cos(5.0 * M_PI / 7.0)), 1e-12);
+}
+
+// The closed form λmax = 2ω² sin²((2m − 1)π/(2(2m + 1))) against a dense eigenvalue solve of the
+// linear springs' Hessian (tridiag(−1, 2, −1) with a free last row, times ω²/2), m = 1 … 50.
+TEST(SlowFastFermiPastaUlam, FastEigenvalueMaxMatchesADenseSolve) {
+  for (const double omega : {1.0, std::sqrt(10.0), 50.0}) {
+    for (int m = 1; m <= 50; ++m) {
+      Eigen::MatrixXd k = Eigen::MatrixXd::Zero(m, m);
+      for (int i = 0; i < m; ++i) {
+        k(i, i) = (i == m - 1) ? 1.0 : 2.0;
+        if (i > 0) k(i, i - 1) = k(i - 1, i) = -1.0;
+      }
+      const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(k, Eigen::EigenvaluesOnly);
+      const double dense = 0.5 * omega * omega * solver.eigenvalues().maxCoeff();
+      EXPECT_NEAR(SlowFastFermiPastaUlam(m, omega).fastEigenvalueMax(), dense, 1e-12 * dense)
+          << "m = " << m << ", omega = " << omega;
+    }
+  }
+  // Large m is O(1) work and tends to 2ω² (the Gershgorin bound 4 × ω²/2) from below.
+  const double large = SlowFastFermiPastaUlam(1'000'000, 1.0).fastEigenvalueMax();
+  EXPECT_LT(large, 2.0);
+  EXPECT_GT(large, 2.0 - 1e-10);
 }
 
 TEST(InhomogeneousWave, SpringsAndPartition) {
