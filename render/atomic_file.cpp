@@ -2,14 +2,17 @@
 // is followed (its target is replaced, the link kept); a device or other special file is refused.
 #include "atomic_file.h"
 
+#include <pthread.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
 #include <climits>
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
+#include <mutex>
 #include <stdexcept>
 #include <vector>
 
@@ -19,25 +22,70 @@ namespace hamiltone::cli {
 
 namespace {
 
-// The temporary being written, for the signal handler: a fixed buffer, as only async-signal-safe
-// calls (unlink, _exit) may touch it there.
-char pendingTemporary[PATH_MAX + 32] = {};
+// The temporaries being written, for the signal handler: fixed buffers, as only
+// async-signal-safe calls (unlink, _exit) and lock-free atomics may be used there. A slot is
+// claimed (free → filling) by compare-exchange, so two threads never share one; the handler
+// removes only slots marked live, whose name is complete.
+enum SlotState : int { kFree = 0, kFilling = 1, kLive = 2 };
+struct Slot {
+  std::atomic<int> state{kFree};
+  char path[PATH_MAX + 32] = {};
+};
+static_assert(std::atomic<int>::is_always_lock_free);
+Slot liveTemporaries[AtomicFile::kMaxLive];
 
-extern "C" void removeTemporaryAndExit(int signal) {
-  if (pendingTemporary[0] != '\0') ::unlink(pendingTemporary);
+constexpr int kHandledSignals[] = {SIGINT, SIGTERM, SIGHUP,
+                                   SIGXFSZ};  // SIGXFSZ: past the file-size limit (ulimit -f)
+
+extern "C" void removeTemporariesAndExit(int signal) {
+  for (Slot& slot : liveTemporaries)
+    if (slot.state.load() == kLive) ::unlink(slot.path);
   ::_exit(128 + signal);
 }
 
-void setPending(const std::string& path) {
-  if (path.size() + 1 > sizeof pendingTemporary) return;
-  std::memcpy(pendingTemporary, path.c_str(), path.size() + 1);
-  std::signal(SIGINT, removeTemporaryAndExit);
-  std::signal(SIGTERM, removeTemporaryAndExit);
-  std::signal(SIGHUP, removeTemporaryAndExit);
-  std::signal(SIGXFSZ, removeTemporaryAndExit);  // past the file-size limit (ulimit -f)
+void installHandler() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    for (const int s : kHandledSignals) std::signal(s, removeTemporariesAndExit);
+  });
 }
 
-void clearPending() { pendingTemporary[0] = '\0'; }
+// The slot now holding `path`, or -1 when it cannot be held (then the caller gives up).
+int addLive(const std::string& path) {
+  if (path.size() + 1 > sizeof Slot::path) return -1;
+  for (int i = 0; i < AtomicFile::kMaxLive; ++i) {
+    int expected = kFree;
+    if (!liveTemporaries[i].state.compare_exchange_strong(expected, kFilling)) continue;
+    std::memcpy(liveTemporaries[i].path, path.c_str(), path.size() + 1);
+    liveTemporaries[i].state.store(kLive);
+    installHandler();
+    return i;
+  }
+  return -1;
+}
+
+void removeLive(int& slot) {
+  if (slot >= 0) liveTemporaries[slot].state.store(kFree);
+  slot = -1;
+}
+
+// Holds the handled signals back on this thread while alive; a held signal is delivered (and
+// ends the program) when it ends.
+class SignalsHeld {
+ public:
+  SignalsHeld() {
+    sigset_t held;
+    sigemptyset(&held);
+    for (const int s : kHandledSignals) sigaddset(&held, s);
+    ::pthread_sigmask(SIG_BLOCK, &held, &previous_);
+  }
+  ~SignalsHeld() { ::pthread_sigmask(SIG_SETMASK, &previous_, nullptr); }
+  SignalsHeld(const SignalsHeld&) = delete;
+  SignalsHeld& operator=(const SignalsHeld&) = delete;
+
+ private:
+  sigset_t previous_;
+};
 
 }  // namespace
 
@@ -66,19 +114,34 @@ AtomicFile::AtomicFile(std::string path, const std::string& flag) : path_(std::m
   std::string pattern = path_ + ".tmp-XXXXXX";
   std::vector<char> name(pattern.begin(), pattern.end());
   name.push_back('\0');
-  const int fd = mkstemp(name.data());
+  // The signal handler must know the temporary from the moment it exists: hold the signals
+  // until it is in the table.
+  int fd = -1;
+  {
+    SignalsHeld held;
+    fd = mkstemp(name.data());
+    if (fd >= 0) {
+      slot_ = addLive(name.data());
+      if (slot_ < 0) {
+        ::close(fd);
+        ::unlink(name.data());
+        throw std::runtime_error(flag + " = " + path_ +
+                                 ": too many output files open at once (at most " +
+                                 std::to_string(kMaxLive) + ")");
+      }
+    }
+  }
   if (fd < 0)
     throw UsageError(flag + " = " + path_ + ": cannot write there (" + std::strerror(errno) +
                      "); expected a path in an existing, writable directory");
   temporary_ = name.data();
-  setPending(temporary_);
   ::fchmod(fd, mode);
   file_ = fdopen(fd, "w");
   if (!file_) {
     const int err = errno;
     ::close(fd);
     std::remove(temporary_.c_str());
-    clearPending();
+    removeLive(slot_);
     throw UsageError(flag + " = " + path_ + ": cannot write there (" + std::strerror(err) + ")");
   }
 }
@@ -86,19 +149,58 @@ AtomicFile::AtomicFile(std::string path, const std::string& flag) : path_(std::m
 AtomicFile::~AtomicFile() {
   if (file_) std::fclose(file_);
   if (!temporary_.empty()) std::remove(temporary_.c_str());
-  clearPending();
+  removeLive(slot_);
 }
 
-void AtomicFile::commit() {
+void AtomicFile::finish() {
+  if (finished_) return;
+  if (!file_) throw std::logic_error("AtomicFile::finish after a failed finish");
+  errno = 0;
   const bool written = std::fflush(file_) == 0 && !std::ferror(file_);
+  const int writeError = errno;
   const bool closed = std::fclose(file_) == 0;
+  const int closeError = errno;
   file_ = nullptr;
   if (!written || !closed)
-    throw std::runtime_error("writing " + path_ + " failed: " + std::strerror(errno));
+    throw std::runtime_error(
+        "writing " + path_ + " failed: " +
+        (!written ? (writeError != 0 ? std::strerror(writeError) : "an earlier write failed")
+                  : std::strerror(closeError)));
+  finished_ = true;
+}
+
+void AtomicFile::publish() {
+  if (!finished_) throw std::logic_error("AtomicFile::publish before finish");
+  if (temporary_.empty()) return;  // already published
   if (std::rename(temporary_.c_str(), path_.c_str()) != 0)
     throw std::runtime_error("cannot move the output onto " + path_ + ": " + std::strerror(errno));
   temporary_.clear();
-  clearPending();
+  removeLive(slot_);
+}
+
+void AtomicFile::commit() {
+  finish();
+  SignalsHeld held;
+  publish();
+}
+
+void commitTogether(std::initializer_list<AtomicFile*> files) {
+  for (AtomicFile* file : files)
+    if (file) file->finish();  // the first failure throws; the destructors remove them all
+  SignalsHeld held;
+  std::vector<AtomicFile*> created;  // published where no file was: removed again on a failure
+  for (AtomicFile* file : files) {
+    if (!file) continue;
+    struct stat existing {};
+    const bool isNew = ::lstat(file->path().c_str(), &existing) != 0;
+    try {
+      file->publish();
+    } catch (...) {
+      for (AtomicFile* done : created) ::unlink(done->path().c_str());
+      throw;
+    }
+    if (isNew) created.push_back(file);
+  }
 }
 
 }  // namespace hamiltone::cli

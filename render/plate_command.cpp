@@ -183,8 +183,7 @@ int runPlateCommand(const PlateArguments& a) {
     auto scheme = building([&] { return SplitSav<VonKarmanPlate>(plate, params, start); });
     return simulate(scheme, probe, steps, every, file.stream(), watcher);
   }();
-  file.commit();
-  if (snapshotFile) snapshotFile->commit();
+  commitTogether({&file, snapshotFile ? &*snapshotFile : nullptr});  // both files or neither
   printSummary("plate",
                a.scheme + ", " + std::to_string(plate.nx()) + "x" + std::to_string(plate.ny()) +
                    " points, k = " + a.k + " s",

@@ -1,5 +1,6 @@
-// `--snapshots T1,T2,… --snapshot-out FILE` of the string and plate subcommands: the whole field
-// at the first step at or after each requested time, for the figures of docs/validation.md.
+// `--snapshots T1,T2,… --snapshot-out FILE` of the string and plate subcommands (wave shares the
+// flag check): the whole field at the first step at or after each requested time, for the
+// figures of docs/validation.md.
 #pragma once
 
 #include <cstdio>
@@ -12,7 +13,8 @@
 
 namespace hamiltone::cli {
 
-// Refuses one flag without the other, and a snapshot file that is also --out.
+// Refuses one flag without the other, and a snapshot file that is also --out however spelled
+// (./a.csv, a symlink or a hard link to it): exit 2 naming --snapshot-out.
 void checkSnapshotFlags(const std::string& times, const std::string& file, const std::string& out);
 
 // "t1,t2,..." as step indices: ceil(t / k), each t in [0, steps k], sorted, duplicates merged.

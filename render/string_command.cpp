@@ -220,8 +220,7 @@ int runStringCommand(const StringArguments& a) {
     summary =
         run(a.scheme, string, start, params, probeIndex, steps, every, file.stream(), watcher);
   }
-  file.commit();
-  if (snapshotFile) snapshotFile->commit();
+  commitTogether({&file, snapshotFile ? &*snapshotFile : nullptr});  // both files or neither
   printSummary("string",
                a.scheme + ", " + std::to_string(segments) + " segments, k = " + a.k + " s", a.out,
                summary);

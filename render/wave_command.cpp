@@ -17,6 +17,7 @@
 #include "models/nonlinear_wave.h"
 #include "number_arguments.h"
 #include "schemes/variable_step_marazzato.h"
+#include "snapshots.h"
 #include "usage_error.h"
 
 namespace hamiltone::cli {
@@ -97,15 +98,16 @@ CLI::App* addWaveCommand(CLI::App& app, WaveArguments& a) {
   number("--amplitude", a.amplitude, "NUMBER", "u0, the amplitude of the start (> 0)");
   number("--dx", a.dx, "NUMBER", "element width; 1/dx must be a whole number from 2 to 1e6");
   number("--k", a.k, "SECONDS",
-         "time step (> 0); with --adaptive the first and largest step. Linear stability: "
-         "k < dx/√3");
+         "time step (> 0); with --adaptive the first and largest step. Must be below the "
+         "linear stability bound dx/√3");
   number("--duration", a.duration, "SECONDS", "simulated time (> 0)");
   number("--every", a.every, "INT", "write every N-th step (>= 1); n = 0 is always written");
   wave->add_flag("--adaptive", a.adaptive,
                  "adapt the step to keep ⅛[p]ᵀM⁻¹[p] <= eps_fly H̃ ([M Remark 8]; see below)");
-  number("--eps-fly", a.epsFly, "NUMBER", "the bound of --adaptive (> 0; the paper's 0.03 %)");
+  number("--eps-fly", a.epsFly, "NUMBER",
+         "with --adaptive (only): its bound (> 0; the paper's 0.03 %)");
   number("--min-step", a.minStep, "SECONDS",
-         "with --adaptive: the run fails rather than use a smaller step (> 0, <= k; default "
+         "with --adaptive (only): the run fails rather than use a smaller step (> 0, <= k; default "
          "k/1024)");
   wave->add_option("--snapshots", a.snapshots,
                    "comma-separated times (0 to --duration) at which to write the shape")
@@ -114,6 +116,12 @@ CLI::App* addWaveCommand(CLI::App& app, WaveArguments& a) {
                    "CSV file for --snapshots (needed with it): t,x,u1,u2, one row per node")
       ->type_name("PATH");
   addOutputOption(wave, a.out);
+  // Whether --eps-fly and --min-step were typed at all (an empty value included), for the check
+  // that they come with --adaptive.
+  wave->parse_complete_callback([wave, &a] {
+    a.epsFlyGiven = wave->count("--eps-fly") > 0;
+    a.minStepGiven = wave->count("--min-step") > 0;
+  });
   wave->footer(
       "CSV: a header, then one row per written step n: t,h,pseudo_energy,energy,gap,u1_mid,"
       "u2_mid.\n"
@@ -146,23 +154,47 @@ int runWaveCommand(const WaveArguments& a) {
     throw UsageError("--dx = " + a.dx +
                      ": 1/dx must be a whole number from 2 to 1000000 (e.g. 0.01, 0.005)");
   const double k = parseReal("--k", a.k, Range::positive, "seconds");
+  // The stability bound of the scheme (6) on this string. Linearised with stiffness matrix K and
+  // an exact quadrature (any rule integrates a linear force exactly), (6) is the recurrence
+  // (z + 1)(z² + (k²ω² − 2) z + 1) = 0 per mode ω² of M⁻¹K: the leapfrog's roots and the
+  // parasitic −1, bounded iff k ω < 2. V's Hessian has the eigenvalues 1 (along (1 + u1, u2))
+  // and 1 − α/|(1 + u1, u2)| (1 − α at rest), so no wave is faster than c = 1 and the largest ω
+  // is that of the c = 1 string: with P1 elements and the consistent mass Δx tridiag(1/6, 2/3,
+  // 1/6), ω² = 4s / (Δx² (1 − 2s/3)), s = sin²(θ/2) → 1 at the top mode, ω_max → √12/Δx, so
+  // k < Δx/√3. That is necessary near rest, where u1 waves travel at exactly c = 1 (the finite
+  // grid's top mode has s = cos²(πΔx/2), which moves the exact bound up by a relative 1.5
+  // (πΔx/2)², 4e-4 at Δx = 0.01: measured stable at 0.005774, diverging at 0.005776, for α = 0).
+  // It is not sufficient far from rest: the paper's largest working step at α = 0.99 was found
+  // empirically (0.0055 at Δx = 0.01), and such runs are the divergence warning's business. The
+  // adaptive run starts at --k, so the bound holds there too.
+  const double stableBelow = dx / std::sqrt(3.0);
+  if (!(k < stableBelow))
+    throw UsageError("--k = " + a.k +
+                     ": at or above the stability bound --dx/√3 = " + formatNumber(stableBelow) +
+                     " s for --dx = " + a.dx + "; expected a smaller step (or a larger --dx)");
   const double duration = parseReal("--duration", a.duration, Range::positive, "seconds");
   const long every = parseInteger("--every", a.every, 1);
   const long steps = stepCount(duration, k);  // the fixed step's count; bounds the adaptive run
   checkOutputSize(steps, every, 7);
   AdaptiveStep adaptive{.enabled = a.adaptive, .growAfter = kGrowAfter};
-  if (a.adaptive) {
+  if (!a.adaptive) {
+    if (a.epsFlyGiven)
+      throw UsageError("--eps-fly = '" + a.epsFly +
+                       "': needs --adaptive (it bounds the adaptive step); give both or neither");
+    if (a.minStepGiven)
+      throw UsageError("--min-step = '" + a.minStep +
+                       "': needs --adaptive (the smallest adaptive step); give both or neither");
+  } else {
+    // An empty value, given, is refused as not a number rather than taken as the default.
     adaptive.epsilonFly = parseReal("--eps-fly", a.epsFly, Range::positive);
-    adaptive.minStep = a.minStep.empty()
-                           ? k * kMinStepFraction
-                           : parseReal("--min-step", a.minStep, Range::positive, "seconds");
+    adaptive.minStep = a.minStepGiven
+                           ? parseReal("--min-step", a.minStep, Range::positive, "seconds")
+                           : k * kMinStepFraction;
     if (adaptive.minStep > k)
       throw UsageError("--min-step = " + a.minStep +
                        ": out of range; expected at most --k = " + a.k + " s");
   }
-  if (a.snapshots.empty() != a.snapshotOut.empty())
-    throw UsageError(a.snapshots.empty() ? "--snapshot-out needs --snapshots"
-                                         : "--snapshots needs --snapshot-out");
+  checkSnapshotFlags(a.snapshots, a.snapshotOut, a.out);
   std::vector<double> snapshots;
   if (!a.snapshots.empty()) snapshots = parseSnapshotTimes(a.snapshots, duration);
 
@@ -176,6 +208,14 @@ int runWaveCommand(const WaveArguments& a) {
   if (!std::isfinite(start))
     throw UsageError("the start's pseudo-energy is " + std::to_string(start) +
                      ": --amplitude is too large for double precision");
+  // H̃⁰ = V(q⁰) >= 0. At 0 or below the normal doubles (a tiny --amplitude) there is no energy
+  // to measure drift against; the adaptive bound gap <= eps_fly H̃ cannot hold there at all.
+  const bool hasEnergy = std::isnormal(start);
+  if (a.adaptive && !hasEnergy)
+    throw UsageError("--amplitude = " + a.amplitude + ": the start's pseudo-energy is " +
+                     formatNumber(start) +
+                     ", too small for --adaptive's bound gap <= eps_fly H̃; expected a larger "
+                     "--amplitude");
 
   AtomicFile file(a.out, "--out");
   std::unique_ptr<AtomicFile> shapes;
@@ -202,7 +242,7 @@ int runWaveCommand(const WaveArguments& a) {
     }
     if (diverged) break;
     maxDrift = std::max(maxDrift, std::abs(pseudo - start));
-    maxGap = std::max(maxGap, (scheme.discreteEnergy() - pseudo) / pseudo);
+    if (hasEnergy) maxGap = std::max(maxGap, (scheme.discreteEnergy() - pseudo) / pseudo);
     for (; nextSnapshot < snapshots.size() && snapshots[nextSnapshot] <= t + slack; ++nextSnapshot)
       writeShape(scheme, shapes->stream());
     const bool done =
@@ -214,11 +254,9 @@ int runWaveCommand(const WaveArguments& a) {
                                "needs a step below --min-step = " + formatNumber(adaptive.minStep) +
                                " s; no file written. Raise --eps-fly or lower --min-step");
   }
-  if (shapes) {
+  if (shapes)
     for (; nextSnapshot < snapshots.size(); ++nextSnapshot) writeShape(scheme, shapes->stream());
-    shapes->commit();
-  }
-  file.commit();
+  commitTogether({&file, shapes.get()});  // both files or neither
 
   std::printf(
       "wave: marazzato (6), %s, alpha = %s, amplitude = %s, dx = %s (%d nodes per "
@@ -229,9 +267,15 @@ int runWaveCommand(const WaveArguments& a) {
   std::printf("rejected steps: %ld\n", scheme.rejectedSteps());
   std::printf("force evaluations: %ld\n", scheme.forceEvaluations());
   std::printf("pseudo-energy at t = 0: %.17g\n", start);
-  std::printf("max relative pseudo-energy drift: %.6g\n", maxDrift / std::abs(start));
+  if (hasEnergy)
+    std::printf("max relative pseudo-energy drift: %.6g\n", maxDrift / std::abs(start));
+  else
+    std::printf("max relative pseudo-energy drift: no energy to drift\n");
   std::printf("max absolute pseudo-energy drift: %.6g\n", maxDrift);
-  std::printf("max gap / pseudo-energy: %.6g\n", maxGap);
+  if (hasEnergy)
+    std::printf("max gap / pseudo-energy: %.6g\n", maxGap);
+  else
+    std::printf("max gap / pseudo-energy: no energy to drift\n");
   if (scheme.stepIndex() > 0) {
     std::printf("min step: %.17g\n", scheme.minStepUsed());
     std::printf("max step: %.17g\n", scheme.maxStepUsed());

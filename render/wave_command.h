@@ -13,7 +13,8 @@ struct WaveArguments {
   std::string alpha = "0.99", amplitude = "0.3", dx = "0.01";
   std::string k = "0.0033", duration = "1", every = "1";
   bool adaptive = false;
-  std::string epsFly = "3e-4", minStep;  // minStep empty: k / 1024
+  std::string epsFly = "3e-4", minStep;            // minStep not given: k / 1024
+  bool epsFlyGiven = false, minStepGiven = false;  // typed on the command line (need --adaptive)
   std::string snapshots, snapshotOut;
   std::string out;
 };

@@ -145,8 +145,35 @@ TEST_F(PlateCli, SnapshotsRefuseBadRequests) {
   expectRefused(ok + to + " --snapshots soon", "--snapshots");
   expectRefused(ok + to + " --snapshots 2.05e-3", "--snapshots");
   expectRefused(ok + " --snapshots 0 --snapshot-out " + csv().string(), "--snapshot-out");
+  // The same file however spelled.
+  expectRefused(ok + " --snapshots 0 --snapshot-out " + (dir_ / "." / "run.csv").string(),
+                "--snapshot-out");
+  expectRefused(ok + " --snapshots 0 --snapshot-out " + (dir_ / "no" / ".." / "run.csv").string(),
+                "--snapshot-out");
   expectRefused(ok + " --snapshots 0 --snapshot-out " + (dir_ / "no" / "x.csv").string(),
                 "--snapshot-out");
+}
+
+// A full disk under either of the two files: exit 1 naming it, and neither file appears, nor a
+// temporary — the one that was written whole is not published alone.
+TEST_F(PlateCli, AFullDiskForEitherFileLeavesNeither) {
+  const fs::path full = dir_ / "full";
+  hamiltone::test::TinyDisk disk(full);
+  if (!disk.mounted()) GTEST_SKIP() << "cannot mount a 64 KiB tmpfs here (needs root)";
+  // Six fields of 225 nodes (about 100 KB) overflow it; the 21-row main CSV does not.
+  CliResult r = run(std::string(kSmall) + " --snapshots 0,4e-4,8e-4,1.2e-3,1.6e-3,2e-3" +
+                    " --snapshot-out " + (full / "snap.csv").string() + " --out " + csv().string());
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_NE(r.err.find("snap.csv"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(csv()));
+  EXPECT_TRUE(fs::is_empty(full));
+  // The other way round: 1001 rows of the main CSV (about 90 KB) overflow it, one field fits.
+  r = run("plate --k 1e-4 --duration 0.1 --snapshots 0 --snapshot-out " + snapshots().string() +
+          " --out " + (full / "run.csv").string());
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_NE(r.err.find("run.csv"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(snapshots()));
+  EXPECT_TRUE(fs::is_empty(full));
 }
 
 }  // namespace

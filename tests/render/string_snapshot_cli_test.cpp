@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -112,6 +113,8 @@ TEST_F(StringSnapshotCli, RefusesBadRequestsNamingTheFlagAndWritesNothing) {
       {"--snapshots 1e-4,,2e-4" + snap + files, "--snapshots"},  // empty item
       {"--snapshots nan" + snap + files, "--snapshots"},         // not finite
       {"--snapshots 1e-4 --snapshot-out /nonexistent/dir/s.csv" + files, "--snapshot-out"},
+      {"--snapshots 1e-4 --snapshot-out " + (dir_ / "." / "run.csv").string() + files,
+       "--snapshot-out"},  // --out, spelled differently
   };
   for (const auto& [args, flag] : cases) {
     const CliResult r = run(kRun + args);
@@ -121,6 +124,22 @@ TEST_F(StringSnapshotCli, RefusesBadRequestsNamingTheFlagAndWritesNothing) {
     EXPECT_FALSE(fs::exists(path("run.csv"))) << args;
     EXPECT_FALSE(fs::exists(path("snap.csv"))) << args;
   }
+}
+
+// Past the file-size limit (ulimit -f) with both files open, SIGXFSZ ends the run with 128 + 25
+// and removes both temporaries, not just the last one made.
+TEST_F(StringSnapshotCli, AFileSizeLimitLeavesNeitherFileNorTemporary) {
+  // 201 fields of 41 nodes (about 700 KB) and 201 rows against a limit of a few KB.
+  std::string times = "0";
+  for (int i = 1; i <= 200; ++i) {
+    times += ',';
+    times += std::to_string(i * 1e-6);
+  }
+  const int code = shell("ulimit -f 16 && " + std::string(HAMILTONE_SIM) + " string " + kRun +
+                         "--snapshots " + times + " --snapshot-out " + path("snap.csv") +
+                         " --out " + path("run.csv") + " >/dev/null 2>&1");
+  if (code != 128 + SIGXFSZ) GTEST_SKIP() << "ulimit -f did not take (exit " << code << ")";
+  EXPECT_TRUE(fs::is_empty(dir_)) << fs::directory_iterator(dir_)->path();
 }
 
 }  // namespace

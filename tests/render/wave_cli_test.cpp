@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -162,6 +163,88 @@ TEST_F(WaveCli, RefusesBadInput) {
   expectRefused(ok + " --snapshots 0.1,abc --snapshot-out " + path("s.csv"), "--snapshots");
   expectRefused(ok + " --snapshots 0.1, --snapshot-out " + path("s.csv"), "--snapshots");
   expectRefused("--alpha 0.5", "--out");
+}
+
+// k < dx/√3, the scheme's linear stability bound (c = 1, consistent mass), in both modes; the
+// message names --k, the bound and --dx.
+TEST_F(WaveCli, RefusesAStepAtOrAboveTheStabilityBound) {
+  const std::string ok = "--duration 0.02 --out " + path("run.csv");
+  for (const std::string& args : {ok + " --k 0.006", ok + " --k 0.006 --adaptive",
+                                  ok + " --k 0.0057736", ok + " --dx 0.02 --k 0.0116"}) {
+    expectRefused(args, "--k");
+    expectRefused(args, "--dx");
+    expectRefused(args, args.find("--dx 0.02") != std::string::npos ? "0.0115470" : "0.0057735");
+  }
+  EXPECT_EQ(run(ok + " --k 0.0057").exitCode, 0);
+  EXPECT_EQ(run(ok + " --dx 0.02 --k 0.0115 --adaptive").exitCode, 0);
+}
+
+// --eps-fly and --min-step mean nothing at a fixed step: refused without --adaptive, even when
+// empty; with it, an empty value is refused rather than taken as the default.
+TEST_F(WaveCli, AdaptiveOnlyFlagsNeedAdaptive) {
+  const std::string ok = "--duration 0.02 --out " + path("run.csv");
+  expectRefused(ok + " --eps-fly 1e-3", "--eps-fly");
+  expectRefused(ok + " --eps-fly 1e-3", "--adaptive");
+  expectRefused(ok + " --min-step 1e-4", "--min-step");
+  expectRefused(ok + " --min-step 1e-4", "--adaptive");
+  expectRefused(ok + " --eps-fly 3e-4", "--adaptive");  // the default value, typed
+  expectRefused(ok + " --min-step ''", "--adaptive");
+  expectRefused(ok + " --adaptive --min-step ''", "--min-step");
+  expectRefused(ok + " --adaptive --eps-fly ''", "--eps-fly");
+  EXPECT_EQ(run(ok + " --adaptive --eps-fly 1e-3 --min-step 1e-4").exitCode, 0);
+}
+
+// A start with no energy (a tiny amplitude underflows V to 0): the summary says so instead of a
+// NaN, and --adaptive, whose bound is relative to that energy, is refused naming --amplitude.
+TEST_F(WaveCli, AStartWithNoEnergyHasNoDriftAndNoAdaptiveStep) {
+  const CliResult r = run("--amplitude 1e-200 --duration 0.02 --out " + path("run.csv"));
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(r.out.find("nan"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("inf"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("max relative pseudo-energy drift: no energy to drift"), std::string::npos)
+      << r.out;
+  EXPECT_EQ(summary(r.out).at("pseudo-energy at t = 0"), 0.0);
+  fs::remove(path("run.csv"));
+  expectRefused("--amplitude 1e-200 --adaptive --out " + path("run.csv"), "--amplitude");
+  expectRefused("--amplitude 1e-160 --adaptive --out " + path("run.csv"), "--amplitude");
+}
+
+// --snapshot-out naming --out's file in another spelling is refused, as in string and plate.
+TEST_F(WaveCli, RefusesSnapshotsIntoTheMainCsv) {
+  const std::string ok = "--duration 0.02 --snapshots 0 --out " + path("run.csv");
+  expectRefused(ok + " --snapshot-out " + path("run.csv"), "--snapshot-out");
+  expectRefused(ok + " --snapshot-out " + (dir_ / "." / "run.csv").string(), "--snapshot-out");
+  expectRefused(ok + " --snapshot-out " + dir_.string() + "//run.csv", "--snapshot-out");
+}
+
+// Killed with both files open, the run leaves neither temporary (the signal handler knows both).
+TEST_F(WaveCli, InterruptedRunWithSnapshotsLeavesNoFile) {
+  const int code =
+      shell(std::string(HAMILTONE_SIM) +
+            " wave --dx 0.001 --k 5e-4 --duration 1e4 --every 1000000 --snapshots 0,1e4" +
+            " --snapshot-out " + path("snap.csv") + " --out " + path("run.csv") +
+            " >/dev/null 2>&1 & pid=$!; sleep 0.3; kill -TERM $pid; wait $pid; exit $?");
+  EXPECT_EQ(code, 128 + SIGTERM);
+  EXPECT_TRUE(fs::is_empty(dir_)) << fs::directory_iterator(dir_)->path();
+}
+
+// A full disk under the snapshot file: exit 1, and the main CSV, written whole, is not published
+// alone.
+TEST_F(WaveCli, AFullDiskForTheSnapshotsLeavesNeitherFile) {
+  const fs::path full = dir_ / "full";
+  hamiltone::test::TinyDisk disk(full);
+  if (!disk.mounted()) GTEST_SKIP() << "cannot mount a 64 KiB tmpfs here (needs root)";
+  std::string times = "0";
+  for (int i = 1; i <= 30; ++i) {
+    times += ',';
+    times += std::to_string(i * 0.0033);
+  }  // 31 fields of 101 nodes: about 100 KB
+  const CliResult r = run("--duration 0.1 --snapshots " + times + " --snapshot-out " +
+                          (full / "snap.csv").string() + " --out " + path("run.csv"));
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_NE(r.err.find("snap.csv"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(path("run.csv")));
+  EXPECT_TRUE(fs::is_empty(full));
 }
 
 }  // namespace

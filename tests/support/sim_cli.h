@@ -3,6 +3,7 @@
 #pragma once
 
 #include <gtest/gtest.h>
+#include <sys/mount.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -20,6 +21,26 @@ struct CliResult {
   std::string out, err;
 };
 
+// A full disk to write to: a 64 KiB tmpfs mounted on `dir` while alive. Needs root (or
+// CAP_SYS_ADMIN); mounted() is false where that fails, and the test should skip.
+class TinyDisk {
+ public:
+  explicit TinyDisk(const std::filesystem::path& dir) : dir_(dir) {
+    std::filesystem::create_directories(dir_);
+    mounted_ = ::geteuid() == 0 && ::mount("tmpfs", dir_.c_str(), "tmpfs", 0, "size=64k") == 0;
+  }
+  ~TinyDisk() {
+    if (mounted_) ::umount2(dir_.c_str(), MNT_DETACH);
+  }
+  TinyDisk(const TinyDisk&) = delete;
+  TinyDisk& operator=(const TinyDisk&) = delete;
+  bool mounted() const { return mounted_; }
+
+ private:
+  std::filesystem::path dir_;
+  bool mounted_ = false;
+};
+
 class SimCliTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -31,6 +52,12 @@ class SimCliTest : public ::testing::Test {
     std::filesystem::create_directories(dir_);
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  // `shell` run by /bin/sh; its exit code as the shell reports it (128 + N for a signal N).
+  static int shell(const std::string& shell) {
+    const int status = std::system(shell.c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
 
   // `hamiltone-sim ARGS` with stdin closed; the scratch directory is left as it was.
   CliResult run(const std::string& args) {
