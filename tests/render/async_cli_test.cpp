@@ -22,13 +22,6 @@ namespace fs = std::filesystem;
 class AsyncCli : public hamiltone::test::SimCliTest {
  protected:
   std::string csv() const { return (dir_ / "run.csv").string(); }
-  void expectRefused(const std::string& args, const std::string& mention) {
-    const CliResult r = run(args);
-    EXPECT_EQ(r.exitCode, 2) << args << "\n" << r.err;
-    EXPECT_NE(r.err.find(mention), std::string::npos) << args << "\nstderr: " << r.err;
-    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-    EXPECT_FALSE(fs::exists(csv())) << args;
-  }
 };
 
 TEST_F(AsyncCli, SlowFastSummaryGivesCountsAndEta) {

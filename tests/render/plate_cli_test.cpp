@@ -25,35 +25,8 @@ namespace fs = std::filesystem;
 
 class PlateCli : public hamiltone::test::SimCliTest {
  protected:
-  // The rows after the header (and the main CSV's comment line, when `comment`).
-  static std::vector<std::vector<double>> rows(const fs::path& p, std::string& header,
-                                               bool comment) {
-    std::ifstream in(p);
-    std::string line;
-    if (comment) std::getline(in, line);
-    std::getline(in, header);
-    std::vector<std::vector<double>> result;
-    while (std::getline(in, line)) {
-      std::vector<double> row;
-      std::istringstream cells(line);
-      for (std::string cell; std::getline(cells, cell, ',');) row.push_back(std::stod(cell));
-      result.push_back(row);
-    }
-    return result;
-  }
-
   fs::path csv() const { return dir_ / "run.csv"; }
   fs::path snapshots() const { return dir_ / "snap.csv"; }
-
-  // Exit 2, a single line on stderr that mentions `mention`, nothing on stdout, no file left.
-  void expectRefused(const std::string& args, const std::string& mention) {
-    const CliResult r = run(args);
-    EXPECT_EQ(r.exitCode, 2) << args << "\n" << r.err;
-    EXPECT_NE(r.err.find(mention), std::string::npos) << args << "\nstderr: " << r.err;
-    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-    EXPECT_TRUE(r.out.empty()) << r.out;
-    EXPECT_TRUE(fs::is_empty(dir_)) << args << ": left a file behind";
-  }
 };
 
 // k = 1e-4 puts the paper's plate on a 14 × 14 segment grid (the bound (84)): fast in any scheme.
@@ -70,8 +43,8 @@ TEST_F(PlateCli, ImplicitSchemeConservesItsEnergyAndTracksTheSplitScheme) {
   ASSERT_EQ(r.exitCode, 0) << r.err;
   EXPECT_NE(r.out.find("implicit, 13x13 points"), std::string::npos) << r.out;
   std::string header, splitHeader;
-  const auto implicit = rows(csv(), header, true);
-  const auto reference = rows(split, splitHeader, true);
+  const auto implicit = parseCsv(slurp(csv()), header);
+  const auto reference = parseCsv(slurp(split), splitHeader);
   EXPECT_EQ(header, "t,q,energy,psi");
   ASSERT_EQ(implicit.size(), 21u);
   ASSERT_EQ(reference.size(), 21u);
@@ -102,8 +75,8 @@ TEST_F(PlateCli, SnapshotsHoldTheWholeFieldAtTheRequestedSteps) {
             " --snapshot-out " + snapshots().string() + " --snapshots 1.05e-3,0,5e-4,1e-3");
     ASSERT_EQ(r.exitCode, 0) << scheme << ": " << r.err;
     std::string header, mainHeader;
-    const auto fields = rows(snapshots(), header, false);
-    const auto main = rows(csv(), mainHeader, true);
+    const auto fields = parseCsv(slurp(snapshots()), header);
+    const auto main = parseCsv(slurp(csv()), mainHeader);
     EXPECT_EQ(header, "t,x,y,w");
     const int nodes = 15 * 15;
     ASSERT_EQ(fields.size(), 4u * nodes) << scheme;

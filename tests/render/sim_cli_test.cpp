@@ -23,30 +23,7 @@ namespace fs = std::filesystem;
 class SimCli : public hamiltone::test::SimCliTest {
  protected:
   std::string csv() const { return (dir_ / "run.csv").string(); }
-
-  // Exit 2, a single line on stderr that mentions `mention`, nothing on stdout, no file left.
-  void expectRefused(const std::string& args, const std::string& mention) {
-    const CliResult r = run(args);
-    EXPECT_EQ(r.exitCode, 2) << args << "\n" << r.err;
-    EXPECT_NE(r.err.find(mention), std::string::npos) << args << "\nstderr: " << r.err;
-    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-    EXPECT_TRUE(r.out.empty()) << r.out;
-    EXPECT_TRUE(fs::is_empty(dir_)) << args << ": left a file behind";
-  }
 };
-
-std::vector<std::vector<double>> parseRows(const std::string& text, std::string& header) {
-  std::istringstream in(text);
-  std::getline(in, header);
-  std::vector<std::vector<double>> rows;
-  for (std::string line; std::getline(in, line);) {
-    std::vector<double> row;
-    std::istringstream cells(line);
-    for (std::string cell; std::getline(cells, cell, ',');) row.push_back(std::stod(cell));
-    rows.push_back(row);
-  }
-  return rows;
-}
 
 TEST_F(SimCli, WritesTheDocumentedCsv) {
   const CliResult r =
@@ -54,7 +31,7 @@ TEST_F(SimCli, WritesTheDocumentedCsv) {
   ASSERT_EQ(r.exitCode, 0) << r.err;
   EXPECT_NE(r.out.find("max relative energy drift (51)"), std::string::npos) << r.out;
   std::string header;
-  const auto rows = parseRows(slurp(csv()), header);
+  const auto rows = parseCsv(slurp(csv()), header);
   EXPECT_EQ(header, "t,q1,q2,q3,q4,q5,q6,energy,kinetic,potential");
   // Steps 0, 3, 6, 9 of 10.
   ASSERT_EQ(rows.size(), 4u);
@@ -80,7 +57,7 @@ TEST_F(SimCli, EverySchemeRunsAndDivergenceIsReported) {
   EXPECT_EQ(r.exitCode, 0);
   EXPECT_NE(r.err.find("non-finite"), std::string::npos) << r.err;
   std::string header;
-  const auto rows = parseRows(slurp(csv()), header);
+  const auto rows = parseCsv(slurp(csv()), header);
   ASSERT_FALSE(rows.empty());
   EXPECT_LT(rows.size(), 500u);
   EXPECT_FALSE(std::isfinite(rows.back()[7]) && std::isfinite(rows.back()[4]));
@@ -139,7 +116,7 @@ TEST_F(SimCli, LeavesAnExistingFileAloneOnError) {
 TEST_F(SimCli, TimesAreExactAndTheLastStepIsWritten) {
   ASSERT_EQ(run("fpu --scheme sav --k 0.1 --duration 0.3 --out " + csv()).exitCode, 0);
   std::string header;
-  const auto rows = parseRows(slurp(csv()), header);
+  const auto rows = parseCsv(slurp(csv()), header);
   ASSERT_EQ(rows.size(), 4u);
   for (size_t n = 0; n < rows.size(); ++n) EXPECT_EQ(rows[n][0], static_cast<double>(n) * 0.1);
 }
@@ -194,7 +171,7 @@ TEST_F(SimCli, StringWritesTheDocumentedCsv) {
   EXPECT_EQ(comment.rfind("# segments=909 h=0.00138503850385", 0), 0u) << comment;
   std::string rest((std::istreambuf_iterator<char>(text)), std::istreambuf_iterator<char>());
   std::string header;
-  const auto rows = parseRows(rest, header);
+  const auto rows = parseCsv(rest, header);
   EXPECT_EQ(header, "t,u,v,energy,psi");
   ASSERT_EQ(rows.size(), 8u);  // 3846 steps, every 500
   // (70) at the probe x = L/2 (grid point 454 of 909: x = 0.4994 L), α = 300.
@@ -217,7 +194,7 @@ TEST_F(SimCli, StringImplicitReferenceWritesTheSameCsv) {
   EXPECT_EQ(comment.rfind("# segments=40 ", 0), 0u) << comment;
   std::string rest((std::istreambuf_iterator<char>(text)), std::istreambuf_iterator<char>());
   std::string header;
-  const auto rows = parseRows(rest, header);
+  const auto rows = parseCsv(rest, header);
   EXPECT_EQ(header, "t,u,v,energy,psi");
   ASSERT_EQ(rows.size(), 11u);  // 100 steps, every 10
   for (const auto& row : rows) {
@@ -229,7 +206,7 @@ TEST_F(SimCli, StringImplicitReferenceWritesTheSameCsv) {
   std::istringstream other(slurp(csv()));
   std::getline(other, comment);
   std::string rest2((std::istreambuf_iterator<char>(other)), std::istreambuf_iterator<char>());
-  const auto sav = parseRows(rest2, header);
+  const auto sav = parseCsv(rest2, header);
   ASSERT_EQ(sav.size(), rows.size());
   for (std::size_t i = 0; i < rows.size(); ++i)
     EXPECT_NEAR(rows[i][1], sav[i][1], 1e-3 * std::abs(rows[0][1])) << "row " << i;
@@ -272,7 +249,7 @@ TEST_F(SimCli, PlateWritesTheDocumentedCsv) {
   EXPECT_EQ(comment.rfind("# nx=44 ny=44 h=0.0111111", 0), 0u) << comment;
   std::string rest((std::istreambuf_iterator<char>(text)), std::istreambuf_iterator<char>());
   std::string header;
-  const auto rows = parseRows(rest, header);
+  const auto rows = parseCsv(rest, header);
   EXPECT_EQ(header, "t,q,energy,psi");
   ASSERT_EQ(rows.size(), 11u);
   for (const auto& row : rows) EXPECT_NEAR(row[2], rows[0][2], 1e-10 * rows[0][2]);  // (41)
@@ -297,7 +274,7 @@ TEST_F(SimCli, ParticleWritesTheDocumentedCsv) {
       run("particle --quadrature lobatto3 --k 0.01 --duration 1 --every 10 --out " + csv());
   ASSERT_EQ(r.exitCode, 0) << r.err;
   std::string header;
-  const auto rows = parseRows(slurp(csv()), header);
+  const auto rows = parseCsv(slurp(csv()), header);
   EXPECT_EQ(header, "t,q,p,q_exact,error,energy,kinetic,potential");
   ASSERT_EQ(rows.size(), 11u);  // steps 0, 10, …, 100
   EXPECT_EQ(rows[0][1], 2.0);   // q(π/2) = 2, p = 0: the start t0 = π/2

@@ -30,23 +30,13 @@ struct Row {
 
 class StringSnapshotCli : public hamiltone::test::SimCliTest {
  protected:
-  CliResult run(const std::string& args) { return SimCliTest::run("string " + args); }
+  StringSnapshotCli() { subcommand_ = "string "; }
 
-  // The rows of a CSV whose first line is the header `header`.
+  // The rows of a CSV file whose header is `header`.
   static std::vector<std::vector<double>> read(const std::string& file, const std::string& header) {
-    std::ifstream in(file);
-    std::string line;
-    std::vector<std::vector<double>> rows;
-    while (std::getline(in, line) && line.starts_with('#')) {
-    }
-    EXPECT_EQ(line, header);
-    while (std::getline(in, line)) {
-      std::vector<double> row;
-      std::stringstream s(line);
-      std::string cell;
-      while (std::getline(s, cell, ',')) row.push_back(std::stod(cell));
-      rows.push_back(row);
-    }
+    std::string found;
+    auto rows = parseCsv(slurp(file), found);
+    EXPECT_EQ(found, header);
     return rows;
   }
 };
@@ -116,14 +106,7 @@ TEST_F(StringSnapshotCli, RefusesBadRequestsNamingTheFlagAndWritesNothing) {
       {"--snapshots 1e-4 --snapshot-out " + (dir_ / "." / "run.csv").string() + files,
        "--snapshot-out"},  // --out, spelled differently
   };
-  for (const auto& [args, flag] : cases) {
-    const CliResult r = run(kRun + args);
-    EXPECT_EQ(r.exitCode, 2) << args << "\n" << r.err;
-    EXPECT_NE(r.err.find(flag), std::string::npos) << args << "\nstderr: " << r.err;
-    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-    EXPECT_FALSE(fs::exists(path("run.csv"))) << args;
-    EXPECT_FALSE(fs::exists(path("snap.csv"))) << args;
-  }
+  for (const auto& [args, flag] : cases) expectRefused(kRun + args, flag);
 }
 
 // Past the file-size limit (ulimit -f) with both files open, SIGXFSZ ends the run with 128 + 25

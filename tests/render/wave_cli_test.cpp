@@ -24,31 +24,8 @@ namespace fs = std::filesystem;
 
 class WaveCli : public hamiltone::test::SimCliTest {
  protected:
-  CliResult run(const std::string& args) { return SimCliTest::run("wave " + args); }
-
-  // Exit 2, one line on stderr mentioning `mention`, nothing on stdout, no file left.
-  void expectRefused(const std::string& args, const std::string& mention) {
-    const CliResult r = run(args);
-    EXPECT_EQ(r.exitCode, 2) << args << "\n" << r.err;
-    EXPECT_NE(r.err.find(mention), std::string::npos) << args << "\nstderr: " << r.err;
-    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-    EXPECT_TRUE(r.out.empty()) << r.out;
-    EXPECT_TRUE(fs::is_empty(dir_)) << args << ": left a file behind";
-  }
+  WaveCli() { subcommand_ = "wave "; }
 };
-
-std::vector<std::vector<double>> readCsv(const std::string& text, std::string& header) {
-  std::istringstream in(text);
-  std::getline(in, header);
-  std::vector<std::vector<double>> rows;
-  for (std::string line; std::getline(in, line);) {
-    std::vector<double> row;
-    std::istringstream cells(line);
-    for (std::string cell; std::getline(cells, cell, ',');) row.push_back(std::stod(cell));
-    rows.push_back(row);
-  }
-  return rows;
-}
 
 TEST_F(WaveCli, WritesTheDocumentedCsvAndSummary) {
   // 0.1 / 0.0033 → 30 steps; rows at n = 0, 5, …, 30.
@@ -59,7 +36,7 @@ TEST_F(WaveCli, WritesTheDocumentedCsvAndSummary) {
   ASSERT_EQ(r.exitCode, 0) << r.err;
   EXPECT_TRUE(r.err.empty()) << r.err;
   std::string header;
-  const auto rows = readCsv(slurp(path("run.csv")), header);
+  const auto rows = parseCsv(slurp(path("run.csv")), header);
   EXPECT_EQ(header, "t,h,pseudo_energy,energy,gap,u1_mid,u2_mid");
   ASSERT_EQ(rows.size(), 7u);
   EXPECT_DOUBLE_EQ(rows[0][5], 0.1);  // u(0.5, 0) = u0 sin(π/2)
@@ -89,7 +66,7 @@ TEST_F(WaveCli, SnapshotsHoldEveryNodeAtTheFirstStepAtOrAfterEachTime) {
   ASSERT_EQ(r.exitCode, 0) << r.err;
   EXPECT_NE(r.out.find("snapshots: wrote"), std::string::npos) << r.out;
   std::string header;
-  const auto rows = readCsv(slurp(path("snap.csv")), header);
+  const auto rows = parseCsv(slurp(path("snap.csv")), header);
   EXPECT_EQ(header, "t,x,u1,u2");
   ASSERT_EQ(rows.size(), 3u * 21u);  // 3 times × (19 interior nodes + 2 ends)
   // 0 → t = 0; 0.05 → step 16 (0.0528); 0.1 is past the last step (30 · 0.0033 = 0.099).
@@ -117,7 +94,7 @@ TEST_F(WaveCli, AdaptiveRunReportsItsStepsAndTheGapBound) {
   EXPECT_EQ(s.at("max step"), 0.005);
   EXPECT_EQ(s.at("force evaluations"), s.at("steps") + s.at("rejected steps"));  // midpoint
   std::string header;
-  const auto rows = readCsv(slurp(path("run.csv")), header);
+  const auto rows = parseCsv(slurp(path("run.csv")), header);
   ASSERT_EQ(static_cast<double>(rows.size()), s.at("steps") + 1);
   EXPECT_LE(rows.back()[0], 0.3 + 1e-12);
   EXPECT_GT(rows.back()[0] + s.at("max step"), 0.3);

@@ -7,12 +7,14 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace hamiltone::test {
 
@@ -59,10 +61,10 @@ class SimCliTest : public ::testing::Test {
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   }
 
-  // `hamiltone-sim ARGS` with stdin closed; the scratch directory is left as it was.
+  // `hamiltone-sim [SUBCOMMAND] ARGS` with stdin closed; the scratch directory is left as it was.
   CliResult run(const std::string& args) {
-    const std::string cmd = std::string(HAMILTONE_SIM) + " " + args + " >" + path("stdout") +
-                            " 2>" + path("stderr") + " </dev/null";
+    const std::string cmd = std::string(HAMILTONE_SIM) + " " + subcommand_ + args + " >" +
+                            path("stdout") + " 2>" + path("stderr") + " </dev/null";
     const int status = std::system(cmd.c_str());
     CliResult r{WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(path("stdout")),
                 slurp(path("stderr"))};
@@ -71,7 +73,32 @@ class SimCliTest : public ::testing::Test {
     return r;
   }
 
+  // Exit 2, a single line on stderr that mentions `mention`, nothing on stdout, no file left.
+  void expectRefused(const std::string& args, const std::string& mention) {
+    const CliResult r = run(args);
+    EXPECT_EQ(r.exitCode, 2) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find(mention), std::string::npos) << args << "\nstderr: " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+    EXPECT_TRUE(std::filesystem::is_empty(dir_)) << args << ": left a file behind";
+  }
+
   std::string path(const std::string& name) const { return (dir_ / name).string(); }
+
+  // The rows of a CSV text as numbers, after its leading '#' comment lines and its header.
+  static std::vector<std::vector<double>> parseCsv(const std::string& text, std::string& header) {
+    std::istringstream in(text);
+    while (std::getline(in, header) && header.starts_with('#')) {
+    }
+    std::vector<std::vector<double>> rows;
+    for (std::string line; std::getline(in, line);) {
+      std::vector<double> row;
+      std::istringstream cells(line);
+      for (std::string cell; std::getline(cells, cell, ',');) row.push_back(std::stod(cell));
+      rows.push_back(row);
+    }
+    return rows;
+  }
 
   static std::string slurp(const std::filesystem::path& p) {
     std::ifstream in(p);
@@ -96,6 +123,7 @@ class SimCliTest : public ::testing::Test {
   }
 
   std::filesystem::path dir_;
+  std::string subcommand_;  // "wave ", "string ", …: put before every run's ARGS, if set
 };
 
 }  // namespace hamiltone::test
