@@ -10,6 +10,20 @@
 
 namespace hamiltone {
 
+// [M (9)]: force = Q_n(∇V(q̂^n)) = h Σ_i w_i ∇V((1 − θ_i) q^n + θ_i q^{n+1}), the impulse over the
+// free flight from q^n to q^{n+1}; `gradient(x, grad)` writes ∇V(x). x and grad are workspace.
+template <class Gradient>
+void flightImpulse(const Quadrature& rule, const Vector& q, const Vector& qNext, double h,
+                   Gradient&& gradient, Vector& x, Vector& grad, Vector& force) {
+  force.setZero();
+  for (int i = 0; i < rule.count; ++i) {
+    const double theta = rule.node[i];
+    x = (1.0 - theta) * q + theta * qNext;
+    gradient(x, grad);
+    force += (h * rule.weight[i]) * grad;
+  }
+}
+
 // Quadrature nodes computed anew per interval in [M §4.3.1]'s count: a rule with nodes at both
 // ends of the interval (Gauss–Lobatto) needs n − 1, as its end node is the next interval's start
 // on the same continuous free flight; a Gauss–Legendre rule needs all n.
@@ -46,13 +60,10 @@ class Marazzato {
   void step() noexcept {
     const double k = params_.k;
     qNext_ = q_ + k * system_.inverseMass().cwiseProduct(p_);
-    force_.setZero();
-    for (int i = 0; i < quadrature_.count; ++i) {
-      const double theta = quadrature_.node[i];
-      x_ = (1.0 - theta) * q_ + theta * qNext_;
-      fullGradient(system_, x_, grad_, kq_);
-      force_ += (k * quadrature_.weight[i]) * grad_;
-    }
+    flightImpulse(
+        quadrature_, q_, qNext_, k,
+        [this](const Vector& x, Vector& grad) { fullGradient(system_, x, grad, kq_); }, x_, grad_,
+        force_);
     pNext_ = pPrev_ - 2.0 * force_;
     // rotate: p^{n−½} ← p^{n+½} ← p^{n+3/2},  q^n ← q^{n+1}
     pPrev_.swap(p_);

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "schemes/hamiltonian.h"
+#include "schemes/marazzato.h"
 #include "schemes/quadrature.h"
 #include "schemes/step_parameters.h"
 
@@ -140,13 +141,9 @@ class VariableStepMarazzato {
   // with the free flight q̂^n sampled at the quadrature nodes. Writes only the *Next_ levels.
   void attempt(double h) noexcept {
     qNext_ = q_ + h * v_;
-    force_.setZero();
-    for (int i = 0; i < quadrature_.count; ++i) {
-      const double theta = quadrature_.node[i];
-      x_ = (1.0 - theta) * q_ + theta * qNext_;
-      system_.gradient(x_, grad_);
-      force_ += (h * quadrature_.weight[i]) * grad_;
-    }
+    flightImpulse(
+        quadrature_, q_, qNext_, h,
+        [this](const Vector& x, Vector& grad) { system_.gradient(x, grad); }, x_, grad_, force_);
     forces_ += quadrature_.count;
     pNext_ = pPrev_ - 2.0 * force_;
     system_.applyInverseMass(pNext_, vNext_);
