@@ -53,6 +53,9 @@ DiscreteGradientString::DiscreteGradientString(const NonlinearString& string, do
     : string_(string), k_(k) {
   if (!std::isfinite(k) || k <= 0.0)
     throw std::invalid_argument("k = " + formatNumber(k) + ": must be a finite number > 0");
+  if (string_.grid().longitudinal != string_.segments())
+    throw std::invalid_argument("the discrete-gradient reference (67) is for the single grid of "
+                                "(65): u and v on the same segments");
   const Eigen::Index n = string_.size();
   if (start.q.size() != n || start.p.size() != n)
     throw std::invalid_argument("initial state of size " + std::to_string(start.q.size()) +

@@ -33,8 +33,8 @@ void secondDifference(const double* a, double* out, Eigen::Index n, double c) {
 
 }  // namespace
 
-NonlinearString::NonlinearString(const StringPhysics& p, int segments)
-    : physics_(p), segments_(segments) {
+NonlinearString::NonlinearString(const StringPhysics& p, StringGrid grid)
+    : physics_(p), grid_(grid), segments_(grid.transverse) {
   requirePositive("density", p.density, "kg/m^3");
   requirePositive("area", p.area, "m^2");
   requirePositive("length", p.length, "m");
@@ -47,19 +47,28 @@ NonlinearString::NonlinearString(const StringPhysics& p, int segments)
     throw std::invalid_argument("tension = " + formatNumber(p.tension) +
                                 " N: must be below E*A = " + formatNumber(p.young * p.area) +
                                 " N, or the split potential (65) is not >= 0");
-  if (segments < 2)
-    throw std::invalid_argument("segments = " + std::to_string(segments) + ": must be >= 2");
-  h_ = p.length / segments;
-  const Eigen::Index n = 2 * static_cast<Eigen::Index>(segments - 1);
-  inverseMass_ = Vector::Constant(n, 1.0 / (p.linearDensity() * h_));
-  work1_.setZero(segments);
-  work2_.setZero(segments);
+  if (grid.transverse < 2)
+    throw std::invalid_argument("segments = " + std::to_string(grid.transverse) + ": must be >= 2");
+  if (grid.longitudinal < 1 || grid.transverse % grid.longitudinal != 0)
+    throw std::invalid_argument("longitudinal segments = " + std::to_string(grid.longitudinal) +
+                                ": must be >= 1 and divide the " +
+                                std::to_string(grid.transverse) + " transverse segments");
+  ratio_ = grid.transverse / grid.longitudinal;
+  h_ = p.length / grid.transverse;
+  hv_ = p.length / grid.longitudinal;
+  const Eigen::Index nu = grid.transverse - 1, nv = grid.longitudinal - 1;
+  inverseMass_.resize(nu + nv);
+  inverseMass_.head(nu).setConstant(1.0 / (p.linearDensity() * h_));
+  inverseMass_.tail(nv).setConstant(1.0 / (p.linearDensity() * hv_));
+  for (Vector* w : {&work1_, &work2_, &work3_}) w->setZero(grid.transverse);
+  for (Vector* w : {&cell1_, &cell2_}) w->setZero(grid.longitudinal);
 }
 
 void NonlinearString::applyStiffness(const Vector& q, Vector& out) const {
-  const Eigen::Index n = segments_ - 1;
+  const Eigen::Index n = segments_ - 1, nv = grid_.longitudinal - 1;
   const double invH2 = 1.0 / (h_ * h_);
-  secondDifference(q.data() + n, out.data() + n, n, -physics_.tension * h_ * invH2);  // −T0 h D2 v
+  if (nv > 0)
+    secondDifference(q.data() + n, out.data() + n, nv, -physics_.tension / hv_);  // −T0 h_v D2 v
   const double t = tensionScale_ * physics_.tension * h_;
   if (physics_.inertia == 0.0) {
     secondDifference(q.data(), out.data(), n, -t * invH2);  // −βT0 h D2 u
@@ -87,8 +96,8 @@ double NonlinearString::transverseEigenvalue(int m, double scale) const {
 }
 
 double NonlinearString::longitudinalEigenvalue(int m) const {
-  const double s = std::sin(m * std::numbers::pi / (2.0 * segments_));
-  return physics_.tension / physics_.linearDensity() * 4.0 / (h_ * h_) * s * s;
+  const double s = std::sin(m * std::numbers::pi / (2.0 * grid_.longitudinal));
+  return physics_.tension / physics_.linearDensity() * 4.0 / (hv_ * hv_) * s * s;
 }
 
 void NonlinearString::setTensionRange(double maxScale) {
@@ -110,13 +119,19 @@ double NonlinearString::lossOperatorEigenvalueMax() const {
 }
 
 void NonlinearString::applyLossOperator(const Vector& a, const Vector& b, Vector& out) const {
-  const Eigen::Index n = 2 * static_cast<Eigen::Index>(segments_ - 1);
+  const Eigen::Index n = size(), nu = segments_ - 1;
   out.head(n) = a.head(n) - b.head(n);
-  const double c = -physics_.linearDensity() * h_ / (h_ * h_);  // M (−D2) = −ρA h D2
   double* d = work1_.data();
-  for (Eigen::Index half : {Eigen::Index{0}, n / 2}) {
-    std::copy(out.data() + half, out.data() + half + n / 2, d);
-    secondDifference(d, out.data() + half, n / 2, c);
+  // M (−D2) = −ρA h D2 on each grid, with its own h.
+  const struct {
+    Eigen::Index start, count;
+    double h;
+  } blocks[] = {{0, nu, h_}, {nu, n - nu, hv_}};
+  for (const auto& block : blocks) {
+    if (block.count == 0) continue;
+    std::copy(out.data() + block.start, out.data() + block.start + block.count, d);
+    secondDifference(d, out.data() + block.start, block.count,
+                     -physics_.linearDensity() / block.h);
   }
 }
 
@@ -134,9 +149,17 @@ inline double segmentExcess(double zeta, double eta, double& phi) {
 
 }  // namespace
 
+double NonlinearString::splitPotential(const Vector& q) const {
+  return ratio_ == 1 ? singleGridPotential(q) : twoGridPotential(q);
+}
+
+double NonlinearString::splitGradient(const Vector& q, Vector& grad) const {
+  return ratio_ == 1 ? singleGridGradient(q, grad) : twoGridGradient(q, grad);
+}
+
 // ζ_l = D₋u, η_l = D₋v on the M segments (u_0 = u_M = 0); V' = h (EA − T0)/2 Σ (s_l − 1)².
 // The end segments are taken apart so the loop over the others has no branch and vectorises.
-double NonlinearString::splitPotential(const Vector& q) const {
+double NonlinearString::singleGridPotential(const Vector& q) const {
   const Eigen::Index m = segments_;
   const double* u = q.data();
   const double* v = q.data() + (m - 1);
@@ -154,7 +177,7 @@ double NonlinearString::splitPotential(const Vector& q) const {
 
 // ∂V'/∂ζ_l = c φ_l ζ_l, ∂V'/∂η_l = c φ_l (1 + η_l), c = h (EA − T0); then
 // ∇_u V' = D₋ᵀ(∂V'/∂ζ): (D₋ᵀ w)_j = (w_j − w_{j+1}) / h, likewise for v.
-double NonlinearString::splitGradient(const Vector& q, Vector& grad) const {
+double NonlinearString::singleGridGradient(const Vector& q, Vector& grad) const {
   const Eigen::Index m = segments_;
   const double* u = q.data();
   const double* v = q.data() + (m - 1);
@@ -184,12 +207,101 @@ double NonlinearString::splitGradient(const Vector& q, Vector& grad) const {
   return 0.5 * c * sum;
 }
 
+namespace {
+
+// ζ_l = (u_l − u_{l−1}) / h on the M fine segments, u = 0 beyond both ends; u[j] is point j + 1.
+void transverseStrains(const double* u, Eigen::Index m, double invH, double* zeta) {
+  zeta[0] = u[0] * invH;
+  zeta[m - 1] = -u[m - 2] * invH;
+#pragma omp simd
+  for (Eigen::Index l = 1; l < m - 1; ++l) zeta[l] = (u[l] - u[l - 1]) * invH;
+}
+
+// η_J = (v_J − v_{J−1}) / h_v on the Mv coarse cells, v = 0 beyond both ends.
+void longitudinalStrains(const double* v, Eigen::Index mv, double invHv, double* eta) {
+  if (mv == 1) {
+    eta[0] = 0.0;
+    return;
+  }
+  eta[0] = v[0] * invHv;
+  eta[mv - 1] = -v[mv - 2] * invHv;
+  for (Eigen::Index j = 1; j < mv - 1; ++j) eta[j] = (v[j] - v[j - 1]) * invHv;
+}
+
+// One coarse cell: Σ_{l∈J} (s_l − 1) over its r fine segments (ζ given), storing 1/s_l and
+// returning Σ 1/s_l in `sumInverse`.
+inline double cellExcess(const double* zeta, double eta, int r, double* inverseStretch,
+                         double& sumInverse) {
+  double excess = 0.0, inverse = 0.0;
+  const double a = (1.0 + eta) * (1.0 + eta), b = 2.0 * eta + eta * eta;
+#pragma omp simd reduction(+ : excess, inverse)
+  for (int i = 0; i < r; ++i) {
+    const double stretch = std::sqrt(a + zeta[i] * zeta[i]);
+    excess += (b + zeta[i] * zeta[i]) / (stretch + 1.0);  // s − 1 without cancellation
+    inverseStretch[i] = 1.0 / stretch;
+    inverse += inverseStretch[i];
+  }
+  sumInverse = inverse;
+  return excess;
+}
+
+}  // namespace
+
+// SCHEMES §3b: ε_J = (1/r) Σ_{l∈J} (s_l − 1), V' = (EA − T0)/2 Σ_J h_v ε_J².
+double NonlinearString::twoGridPotential(const Vector& q) const {
+  const Eigen::Index mv = grid_.longitudinal;
+  double* zeta = work1_.data();
+  double* eta = cell1_.data();
+  transverseStrains(q.data(), segments_, 1.0 / h_, zeta);
+  longitudinalStrains(q.data() + (segments_ - 1), mv, 1.0 / hv_, eta);
+  double sum = 0.0, unused;
+  for (Eigen::Index j = 0; j < mv; ++j) {
+    const double strain = cellExcess(zeta + j * ratio_, eta[j], ratio_, work2_.data(), unused) /
+                          ratio_;
+    sum += strain * strain;
+  }
+  return 0.5 * hv_ * (physics_.young * physics_.area - physics_.tension) * sum;
+}
+
+// With c = (EA − T0) h_u and w_l = c ε_J / s_l (SCHEMES §3b):
+//   ∂V'/∂ζ_l = w_l ζ_l,  ∂V'/∂η_J = Σ_{l∈J} w_l (1 + η_J) = c ε_J (1 + η_J) Σ_{l∈J} 1/s_l,
+// then ∇_u V' = D₋ᵀ(∂V'/∂ζ) on the fine grid and ∇_v V' = D₋ᵀ(∂V'/∂η) on the coarse one.
+double NonlinearString::twoGridGradient(const Vector& q, Vector& grad) const {
+  const Eigen::Index m = segments_, mv = grid_.longitudinal;
+  const double invH = 1.0 / h_, invHv = 1.0 / hv_;
+  const double c = (physics_.young * physics_.area - physics_.tension) * h_;
+  double* zeta = work1_.data();  // ζ_l, then ∂V'/∂ζ_l in place
+  double* inverseStretch = work2_.data();
+  double* eta = cell1_.data();
+  double* we = cell2_.data();  // ∂V'/∂η_J
+  transverseStrains(q.data(), m, invH, zeta);
+  longitudinalStrains(q.data() + (m - 1), mv, invHv, eta);
+  double sum = 0.0;
+  for (Eigen::Index j = 0; j < mv; ++j) {
+    double* z = zeta + j * ratio_;
+    double* inv = inverseStretch + j * ratio_;
+    double sumInverse;
+    const double strain = cellExcess(z, eta[j], ratio_, inv, sumInverse) / ratio_;
+    sum += strain * strain;
+    const double w = c * strain;
+#pragma omp simd
+    for (int i = 0; i < ratio_; ++i) z[i] *= w * inv[i];
+    we[j] = w * (1.0 + eta[j]) * sumInverse;
+  }
+  double* gu = grad.data();
+  double* gv = grad.data() + (m - 1);
+#pragma omp simd
+  for (Eigen::Index j = 0; j < m - 1; ++j) gu[j] = (zeta[j] - zeta[j + 1]) * invH;
+  for (Eigen::Index j = 0; j < mv - 1; ++j) gv[j] = (we[j] - we[j + 1]) * invHv;
+  return 0.5 * hv_ * (physics_.young * physics_.area - physics_.tension) * sum;
+}
+
 double minimalSpacing(const StringPhysics& p, GridRule rule, double k, double sigma1) {
   const double c2 = p.tension / p.linearDensity();
   const double kappa2 = p.young * p.inertia / p.linearDensity();
   const double a = c2 * k * k + 4.0 * sigma1 * k;
   const double transverse = std::sqrt(0.5 * (a + std::sqrt(a * a + 16.0 * kappa2 * k * k)));
-  if (rule == GridRule::transverse) return transverse;
+  if (rule != GridRule::longitudinal) return transverse;  // two grids: u's spacing
   return std::max(std::sqrt(p.young / p.density) * k, transverse);
 }
 
@@ -199,7 +311,25 @@ int gridSegments(const StringPhysics& p, GridRule rule, double k, double sigma1,
   const double h = factor * minimalSpacing(p, rule, k, sigma1);
   return segmentsAlong(
       p.length, h, k, 1e6, "length",
-      rule == GridRule::transverse ? "stiff-string bound (44)" : "h >= sqrt(E/rho) k");
+      rule == GridRule::longitudinal ? "h >= sqrt(E/rho) k" : "stiff-string bound (44)");
+}
+
+StringGrid stringGrid(const StringPhysics& p, GridRule rule, double k, double sigma1,
+                      double factor, double tensionMargin) {
+  if (rule != GridRule::twoGrid) {
+    const int m = gridSegments(p, rule, k, sigma1, factor);
+    return {m, m};
+  }
+  if (!(tensionMargin >= 1.0) || !std::isfinite(tensionMargin))
+    throw std::invalid_argument("tension margin = " + formatNumber(tensionMargin) +
+                                ": must be a finite number >= 1 (times the tension)");
+  StringPhysics design = p;
+  design.tension *= tensionMargin;
+  const int fine = gridSegments(design, GridRule::transverse, k, sigma1, factor);
+  const double cL = std::sqrt(p.young / p.density);
+  const double coarse = std::floor(p.length / (kLongitudinalGridFactor * cL * k));
+  const int mv = static_cast<int>(std::clamp(coarse, 1.0, static_cast<double>(fine)));
+  return {fine / mv * mv, mv};
 }
 
 }  // namespace hamiltone

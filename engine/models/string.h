@@ -1,5 +1,6 @@
-// The geometrically exact stiff string of BDZ §4.2: transverse u and longitudinal v on a uniform
-// grid with fixed ends, split as (65) with bending stiffness EI ∂x⁴u added to K.
+// The geometrically exact stiff string of BDZ §4.2: transverse u and longitudinal v on uniform
+// grids with fixed ends, split as (65) with bending stiffness EI ∂x⁴u added to K. v may live on a
+// coarser grid nested in u's (SCHEMES §3b), so that the longitudinal wave is resolved at audio rate.
 #pragma once
 
 #include <algorithm>
@@ -18,22 +19,39 @@ struct StringPhysics {
   double linearDensity() const { return density * area; }  // ρA, kg/m
 };
 
-// q = [u_1 … u_{M−1}, v_1 … v_{M−1}] on x_l = l h, h = L/M; u = v = 0 at both ends, and u'' = 0
-// there too (simply supported) for the stiffness term.
-//   M = ρA h I
-//   K = h [ −T0 D2 + EI D2²   0 ;  0   −T0 D2 ]                        (65) + stiffness
-//   V' = h (EA − T0)/2 Σ_{l=1}^{M} (s_l − 1)²,  s_l = sqrt((1 + η_l)² + ζ_l²),  ζ = D₋u, η = D₋v
+// The two grids: u on `transverse` segments (Mu), v on `longitudinal` segments (Mv), Mu = r·Mv,
+// so every coarse cell J holds r fine segments. Mv = Mu is the single grid of (65); Mv = 1 leaves
+// no longitudinal unknown: the tension follows the mean strain (Kirchhoff–Carrier).
+struct StringGrid {
+  int transverse = 0;
+  int longitudinal = 0;
+  bool operator==(const StringGrid&) const = default;
+};
+
+// q = [u_1 … u_{Mu−1}, v_1 … v_{Mv−1}] on x_l = l h_u and x_J = J h_v, h = L/M; u = v = 0 at both
+// ends, and u'' = 0 there too (simply supported) for the stiffness term. ζ = D₋u on the fine
+// segments, η = D₋v on the coarse ones.
+//   M = ρA diag(h_u I, h_v I)
+//   K = [ h_u (−T0 D2 + EI D2²)   0 ;  0   h_v (−T0 D2) ]                   (65) + stiffness
+//   V' = (EA − T0)/2 Σ_J h_v ε_J²,  ε_J = (1/r) Σ_{l∈J} (s_l − 1),  s_l = sqrt((1 + η_J)² + ζ_l²)
+// the strain averaged over each coarse cell (SCHEMES §3b); with r = 1 it is (65),
+// V' = h (EA − T0)/2 Σ_l (s_l − 1)².
 class NonlinearString {
  public:
   static constexpr bool hasStiffness = true;
 
   // Throws std::invalid_argument naming the parameter if a value is not physical, if EA <= T0
-  // (V' would not be >= 0), or if segments < 2.
-  NonlinearString(const StringPhysics& physics, int segments);
+  // (V' would not be >= 0), if Mu < 2, Mv < 1 or Mv does not divide Mu.
+  NonlinearString(const StringPhysics& physics, StringGrid grid);
+  NonlinearString(const StringPhysics& physics, int segments)  // the single grid of (65)
+      : NonlinearString(physics, StringGrid{segments, segments}) {}
 
   Eigen::Index size() const { return inverseMass_.size(); }
-  int segments() const { return segments_; }
+  int segments() const { return segments_; }  // Mu: u's grid, where the pickups and hammer sit
+  const StringGrid& grid() const { return grid_; }
+  Eigen::Index transverseSize() const { return segments_ - 1; }  // u's share of q, first
   double spacing() const { return h_; }
+  double longitudinalSpacing() const { return hv_; }
   const StringPhysics& physics() const { return physics_; }
 
   const Vector& inverseMass() const { return inverseMass_; }
@@ -56,25 +74,33 @@ class NonlinearString {
   // Eigenvalue m = 1 … M−1 of M⁻¹K on u: (βT0/ρA)(4/h²) s² + (EI/ρA)(16/h⁴) s⁴, s = sin(mπ/2M).
   double transverseEigenvalue(int m) const;
   double transverseEigenvalue(int m, double scale) const;  // at β = scale
-  // Of M⁻¹K on v: (T0/ρA)(4/h²) s².
+  // Of M⁻¹K on v, m = 1 … Mv−1: (T0/ρA)(4/h_v²) s², s = sin(mπ/2Mv).
   double longitudinalEigenvalue(int m) const;
 
  private:
+  double singleGridPotential(const Vector& q) const;
+  double singleGridGradient(const Vector& q, Vector& grad) const;
+  double twoGridPotential(const Vector& q) const;
+  double twoGridGradient(const Vector& q, Vector& grad) const;
+
   StringPhysics physics_;
-  int segments_;
-  double h_;
+  StringGrid grid_;
+  int segments_, ratio_;  // Mu, r = Mu / Mv
+  double h_, hv_;         // h_u, h_v
   Vector inverseMass_;
   double tensionScale_ = 1.0, tensionScaleMax_ = 1.0;
-  mutable Vector work1_, work2_;  // per-segment work of the stencils and the gradient, size M
+  // Work of the stencils and the gradient: per fine segment (size Mu) and per coarse cell (Mv).
+  mutable Vector work1_, work2_, work3_, cell1_, cell2_;
 };
 
 // How the grid spacing h follows from the time step k (BDZ §4.2, SCHEMES §3).
 enum class GridRule {
   transverse,    // the stiff-string bound (44) with the σ1 term: the finest stable grid
   longitudinal,  // h >= sqrt(E/ρ) k: the longitudinal wave resolved, as in the paper's runs
+  twoGrid,       // u on the transverse grid, v on a coarse nested one with h_v >= sqrt(E/ρ) k
 };
 
-// The smallest h the rule allows: transverse h² = (c²k² + 4σ1k + sqrt((c²k² + 4σ1k)² + 16κ²k²))/2
+// The smallest h the rule allows (u's for twoGrid): transverse h² = (c²k² + 4σ1k + sqrt((c²k² + 4σ1k)² + 16κ²k²))/2
 // with c² = T0/ρA, κ² = EI/ρA (the continuous form of maxStableStep, so slightly conservative);
 // longitudinal h = max(sqrt(E/ρ) k, the transverse h).
 double minimalSpacing(const StringPhysics& physics, GridRule rule, double k, double sigma1);
@@ -82,5 +108,17 @@ double minimalSpacing(const StringPhysics& physics, GridRule rule, double k, dou
 // or the string is too short for two segments.
 int gridSegments(const StringPhysics& physics, GridRule rule, double k, double sigma1,
                  double factor);
+
+// v's spacing on the two grids as a multiple of sqrt(E/ρ) k: the longitudinal Courant number is
+// 1/1.05 (SCHEMES §3b; at 1.43 the glide collapses to a quarter of the converged one).
+constexpr double kLongitudinalGridFactor = 1.05;
+
+// The grids of `rule` (SCHEMES §3b for twoGrid). transverse and longitudinal: Mu = Mv =
+// gridSegments(). twoGrid: Mv = max(1, floor(L / (1.05 sqrt(E/ρ) k))); u's finest grid sized for
+// the design tension `tensionMargin`·T0 (stability needs T0, accuracy under tension modulation the
+// margin), coarsened by `factor`, then rounded down to a multiple r·Mv (Mv lowered to it when even
+// r = 1 does not fit). Throws std::invalid_argument like gridSegments(), or for a margin < 1.
+StringGrid stringGrid(const StringPhysics& physics, GridRule rule, double k, double sigma1,
+                      double factor, double tensionMargin);
 
 }  // namespace hamiltone

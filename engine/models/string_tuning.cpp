@@ -17,6 +17,7 @@ double schemePartial(const NonlinearString& string, double k, int m) {
 
 namespace {
 
+// On u's grid alone: the fundamental does not depend on v's.
 double fundamental(StringPhysics p, TuneBy by, double value, int segments, double k) {
   (by == TuneBy::tension ? p.tension : p.length) = value;
   return schemePartial(NonlinearString(p, segments), k, 1);
@@ -50,21 +51,24 @@ double solve(const StringPhysics& p, TuneBy by, int segments, double k, double t
 }  // namespace
 
 TunedString tuneString(const StringPhysics& guess, TuneBy by, GridRule rule, double k,
-                       double sigma1, double gridFactor, double targetHz) {
+                       double sigma1, double gridFactor, double targetHz, double tensionMargin) {
   if (!std::isfinite(targetHz) || targetHz <= 0.0 || targetHz >= 0.5 / k)
     throw std::invalid_argument("target pitch = " + formatNumber(targetHz) +
                                 " Hz: must be between 0 and the Nyquist frequency " +
                                 formatNumber(0.5 / k) + " Hz");
-  TunedString tuned{guess, gridSegments(guess, rule, k, sigma1, gridFactor)};
+  auto grids = [&](const StringPhysics& p) {
+    return stringGrid(p, rule, k, sigma1, gridFactor, tensionMargin);
+  };
+  TunedString tuned{guess, grids(guess)};
   for (int iteration = 0; iteration < 20; ++iteration) {
     double& value = by == TuneBy::tension ? tuned.physics.tension : tuned.physics.length;
-    value = solve(tuned.physics, by, tuned.segments, k, targetHz);
-    const int segments = gridSegments(tuned.physics, rule, k, sigma1, gridFactor);
-    if (segments == tuned.segments) return tuned;
+    value = solve(tuned.physics, by, tuned.grid.transverse, k, targetHz);
+    const StringGrid grid = grids(tuned.physics);
+    if (grid == tuned.grid) return tuned;
     // A grid coarser than the one tuned on would leave the pitch off: retune on the new grid.
     // Alternating between two grids is settled by keeping the coarser (always stable) one.
-    if (iteration >= 10 && segments > tuned.segments) return tuned;
-    tuned.segments = segments;
+    if (iteration >= 10 && grid.transverse > tuned.grid.transverse) return tuned;
+    tuned.grid = grid;
   }
   throw std::invalid_argument("target pitch = " + formatNumber(targetHz) +
                               " Hz: the tuning and the grid rule did not settle");

@@ -14,13 +14,16 @@ enum class TuneBy { tension, length };
 
 struct TunedString {
   StringPhysics physics;  // with the solved tension or length
-  int segments = 0;       // the grid of `rule` at the solved values
+  StringGrid grid;        // the grids of `rule` at the solved values
 };
 
-// Solves T0 (or L) so that schemePartial(…, 1) = targetHz on the grid `rule` gives for it; the grid
-// depends on the solution, so the two are iterated to a fixed point. Throws std::invalid_argument
-// naming the note's parameter when no solution keeps E A > T0, the bound (44) and two segments.
+// Solves T0 (or L) so that schemePartial(…, 1) = targetHz on the grids `rule` gives for it
+// (stringGrid(), with `tensionMargin` for the two grids); the grids depend on the solution, so
+// the two are iterated to a fixed point. The fundamental depends on u's grid alone (V' has no
+// quadratic term in u). Throws std::invalid_argument naming the note's parameter when no solution
+// keeps E A > T0, the bound (44) and two segments.
 TunedString tuneString(const StringPhysics& guess, TuneBy by, GridRule rule, double k,
-                       double sigma1, double gridFactor, double targetHz);
+                       double sigma1, double gridFactor, double targetHz,
+                       double tensionMargin = 1.0);
 
 }  // namespace hamiltone

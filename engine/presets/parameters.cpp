@@ -474,18 +474,34 @@ constexpr Parameter kTable[] = {
      .doc = "Grid spacing as a multiple of the finest stable one: above 1 is cheaper and duller."},
     {.name = "scheme.grid_rule",
      .type = choice,
-     .choices = "transverse|longitudinal",
-     .defaultText = "transverse",
+     .choices = "two-grid|transverse|longitudinal",
+     .defaultText = "two-grid",
      .model = kString,
-     .doc = "transverse: the finest grid the stiff-string bound (44) allows; longitudinal: h >= "
-            "sqrt(E/ρ)k, as in the paper's runs (coarse at audio rates)."},
+     .doc = "two-grid: u on the finest grid (44) allows, v on a coarse nested grid with h_v >= "
+            "1.05 sqrt(E/ρ)k — geometrically exact at audio rate (pitch glide, phantom partials) "
+            "at about half the cost of transverse; transverse: u and v on u's grid (no glide at "
+            "audio rate: v cannot follow); longitudinal: h >= sqrt(E/ρ)k, as in the paper's runs "
+            "(converges with oversampling 8–16, at a cost growing as its square)."},
+    {.name = "scheme.tension_margin",
+     .min = 1,
+     .max = 4,
+     .defaultText = "1.5",
+     .model = kString,
+     .doc = "two-grid: u's grid is sized for this multiple of T0. Stability needs only T0; a "
+            "struck string's tension rises above it, and a grid at the T0 bound then glides at "
+            "half the rate. A larger margin is coarser and cheaper (fewer high partials)."},
     {.name = "scheme.epsilon_J",
      .unit = "J",
      .min = 0,
      .max = 1e9,
-     .defaultText = "0",
+     .defaultText = "by grid",
+     .defaultKind = kDerived,
      .model = kString,
-     .doc = "Gauge shift ε of the scalar auxiliary variable (BDZ §2.5)."},
+     .doc = "Gauge shift ε of the scalar auxiliary variable (BDZ §2.5). two-grid and "
+            "longitudinal: 0.1 × the hardest strike's energy ½ M_H v_max² (any ε > 0 gives the "
+            "converged glide; ε = 0 does not, from a displaced start); any value is accepted. "
+            "transverse (v unresolved): 0, and at most 0.01 × that energy — a larger ε lets ψ "
+            "drift and the output turns into noise."},
     {.name = "scheme.guard_energy_multiple",
      .min = 1.01,
      .max = 1e6,
@@ -548,9 +564,14 @@ size_t columns(std::string_view s) {
       s.begin(), s.end(), [](char c) { return (static_cast<unsigned char>(c) & 0xC0) != 0x80; }));
 }
 
-void cell(std::string& out, std::string_view s, size_t width) {
+// Appends a cell and pads the line to column `at` + `width`, where the cell should end, with at
+// least one space; `at` moves on to there. A cell that overflows takes its columns from the next
+// one rather than widening the line.
+void cell(std::string& out, std::string_view s, size_t width, size_t& at) {
+  const size_t used = columns(out.substr(out.rfind('\n') + 1)) + columns(s);
+  at += width;
   out += s;
-  out.append(width > columns(s) ? width - columns(s) : 1, ' ');
+  out.append(at > used ? at - used : 1, ' ');
 }
 
 // Appends `words` wrapped to 100 columns, each line indented by `indent` spaces.
@@ -645,21 +666,23 @@ std::string parameterTable() {
       out += section.empty()    ? "\n[top level]\n"
              : section == "key" ? "\n[[key]] anchor tables\n"
                                 : "\n[" + std::string(section) + "]\n";
-      cell(out, "  name", kName + 2);
-      cell(out, "type", kType);
-      cell(out, "unit", kUnit);
-      cell(out, "range", kRange);
-      cell(out, "default", kDefault);
+      size_t at = 0;
+      cell(out, "  name", kName + 2, at);
+      cell(out, "type", kType, at);
+      cell(out, "unit", kUnit, at);
+      cell(out, "range", kRange, at);
+      cell(out, "default", kDefault, at);
       out += "model\n";
     }
     const std::string defaultText =
         p.defaultKind == DefaultKind::required ? "required" : std::string(p.defaultText);
     out += "  ";
-    cell(out, p.name, kName);
-    cell(out, typeText(p.type), kType);
-    cell(out, p.unit.empty() ? "-" : p.unit, kUnit);
-    cell(out, rangeText(p), kRange);
-    cell(out, defaultText, kDefault);
+    size_t at = 2;
+    cell(out, p.name, kName, at);
+    cell(out, typeText(p.type), kType, at);
+    cell(out, p.unit.empty() ? "-" : p.unit, kUnit, at);
+    cell(out, rangeText(p), kRange, at);
+    cell(out, defaultText, kDefault, at);
     out += modelText(p.model);
     if (p.perKey) out += ", per key";
     out += '\n';

@@ -16,6 +16,7 @@
 #include <set>
 
 #include "presets/parameters.h"
+#include "util/format_number.h"
 #include "voices/plate_voice.h"
 #include "voices/string_voice.h"
 
@@ -90,11 +91,7 @@ std::string show(const toml::node& v) {
 }
 
 // A value computed for a key rather than written: six significant digits.
-std::string approximate(double x) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.6g", x);
-  return buffer;
-}
+std::string approximate(double x) { return formatSignificant(x, 6); }
 
 std::string_view modelName(InstrumentModel m) {
   return m == InstrumentModel::string ? "string" : "plate";
@@ -301,6 +298,7 @@ constexpr VoiceField kStringFields[] = {
     {"velocity_curve", "hammer.velocity_curve"},
     {"guard_energy_multiple", "scheme.guard_energy_multiple"},
     {"epsilon_j", "scheme.epsilon_J"},
+    {"tension_margin", "scheme.tension_margin"},
     {"bend_range_semitones", "bend_range_semitones"},
     {"tension scale range", "bend_range_semitones", true},
     {"t60_low_s", "loss.t60_low_s"},
@@ -842,11 +840,14 @@ Instrument Loader::build() const {
   StringPatch common;
   common.tuneBy = word("string.tune_by") == "tension" ? TuneBy::tension : TuneBy::length;
   common.a4Hz = number("a4_Hz");
-  common.grid =
-      word("scheme.grid_rule") == "transverse" ? GridRule::transverse : GridRule::longitudinal;
+  const std::string rule = word("scheme.grid_rule");
+  common.grid = rule == "two-grid"     ? GridRule::twoGrid
+                : rule == "transverse" ? GridRule::transverse
+                                       : GridRule::longitudinal;
   common.gridFactor = number("scheme.grid_factor");
+  common.tensionMargin = number("scheme.tension_margin");
   common.oversampling = static_cast<int>(number("scheme.oversampling"));
-  common.epsilon = number("scheme.epsilon_J");
+  if (setting("scheme.epsilon_J")) common.epsilon = number("scheme.epsilon_J");
   common.t60HighHz = number("loss.t60_high_Hz");
   common.pickups[0] = number("pickups.left_position");
   common.pickups[1] = number("pickups.right_position");

@@ -45,6 +45,43 @@ double bendScale(const NonlinearString& s, double k, double hz) {
 
 }  // namespace
 
+double strikeEnergyScale(const StringPatch& patch) {
+  return 0.5 * patch.hammer.mass * patch.velocityMax * patch.velocityMax;
+}
+
+namespace {
+
+// The gauge shift ε (docs/string-grids.md, "The gauge shift"). Where v's grid resolves the
+// longitudinal wave (c_L k / h_v <= 1) any ε > 0 gives the converged glide, and ε = 0 does not
+// (g is direction-dependent at rest: a first-mode start glides at 0.4 of the converged rate), so
+// the default is a share of the hardest strike's energy. Where it does not (the transverse grid,
+// c_L k / h ≈ 15), ψ drifts from sqrt(2 (V' + ε)) by an amount that grows with ε: the output turns
+// into noise from about the strike's energy on, so ε is kept to a hundredth of it, 0 by default.
+double gaugeShift(const StringPatch& patch, const NonlinearString& string, double k) {
+  const StringPhysics& p = string.physics();
+  const double courant = std::sqrt(p.young / p.density) * k / string.longitudinalSpacing();
+  const double strike = strikeEnergyScale(patch);
+  if (courant <= 1.0) {
+    const double epsilon = patch.epsilon.value_or(kEpsilonShare * strike);
+    require(std::isfinite(epsilon) && epsilon >= 0.0, "epsilon_j", epsilon,
+            "a finite number >= 0 J");
+    return epsilon;
+  }
+  const double epsilon = patch.epsilon.value_or(0.0);
+  const double most = kUnresolvedEpsilonShare * strike;
+  require(epsilon >= 0.0 && epsilon <= most, "epsilon_j", epsilon,
+          "between 0 and " + formatSignificant(most, 3) +
+              " J on this grid: its longitudinal Courant number c_L k/h = " +
+              formatSignificant(courant, 3) +
+              " exceeds 1, and a larger gauge shift lets ψ drift from sqrt(2(V'+ε)) until the "
+              "output is noise (at most a hundredth of the hardest strike's energy ½ M_H v_max² "
+              "= " +
+              formatSignificant(strike, 3) + " J; grid_rule \"two-grid\" accepts any ε)");
+  return epsilon;
+}
+
+}  // namespace
+
 StringLoss stringLossFromT60(const StringPhysics& string, double t60Low, double t60High,
                              double highHz) {
   require(t60Low > 0.0, "t60_low_s", t60Low, "> 0 seconds (inf for no loss)");
@@ -80,8 +117,6 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
           patch.velocityCurve, "a number > 0");
   require(patch.guardEnergyMultiple > 1.0, "guard_energy_multiple", patch.guardEnergyMultiple,
           "a number > 1");
-  require(std::isfinite(patch.epsilon) && patch.epsilon >= 0.0, "epsilon_j", patch.epsilon,
-          "a finite number >= 0 J");
   require(patch.bendRange >= 0.0 && patch.bendRange <= 12.0, "bend_range_semitones",
           patch.bendRange, "between 0 and 12 semitones");
 
@@ -94,17 +129,23 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
       equalTemperament(midiNote, patch.a4Hz) * std::pow(2.0, patch.detuneCents / 1200.0);
   // The loss sets the grid (its σ1 tightens (44)) and the tuning sets the loss (ξ depends on T0):
   // two rounds settle both, σ1 being a small correction. The grid leaves room for the bend's
-  // largest tension β: h_min grows at most as sqrt(β) (minimalSpacing), so a coarser factor covers
-  // it; β itself depends on the grid through the stiffness term, hence a third round if needed.
+  // largest tension β: on the single grids h_min grows at most as sqrt(β) (minimalSpacing), so a
+  // coarser factor covers it; the two grids size u's grid for the tension max(β, margin) T0. β
+  // itself depends on the grid through the stiffness term, hence a third round if needed.
+  require(std::isfinite(patch.tensionMargin) && patch.tensionMargin >= 1.0 &&
+              patch.tensionMargin <= 4.0,
+          "tension_margin", patch.tensionMargin, "between 1 and 4 (times the tension)");
   const double widest = std::pow(2.0, 2.0 * patch.bendRange / 12.0);
   double betaMax = widest;
-  TunedString tuned{patch.string, 0};
+  TunedString tuned{patch.string, {}};
   StringLoss loss;
   for (int round = 0; round < 3; ++round) {
     loss = stringLossFromT60(tuned.physics, patch.t60Low, patch.t60High, patch.t60HighHz);
+    const bool two = patch.grid == GridRule::twoGrid;
     tuned = tuneString(patch.string, patch.tuneBy, patch.grid, k, loss.sigma1,
-                       patch.gridFactor * std::sqrt(betaMax), target);
-    const NonlinearString s(tuned.physics, tuned.segments);
+                       patch.gridFactor * (two ? 1.0 : std::sqrt(betaMax)), target,
+                       two ? std::max(betaMax, patch.tensionMargin) : 1.0);
+    const NonlinearString s(tuned.physics, tuned.grid);
     const double need = bendScale(s, k, target * std::pow(2.0, patch.bendRange / 12.0));
     if (round > 0 && need <= betaMax) break;
     betaMax = std::max(widest, need);
@@ -112,7 +153,8 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
   require((loss.sigma0 + kLn1000 / patch.damperT60) * k < 1.0, "damper_t60_s", patch.damperT60,
           "longer than ln(1000) k / (1 − σ0 k) = " +
               formatNumber(kLn1000 * k / (1.0 - loss.sigma0 * k)) + " s at this rate");
-  NonlinearString string(tuned.physics, tuned.segments);
+  NonlinearString string(tuned.physics, tuned.grid);
+  const double epsilon = gaugeShift(patch, string, k);
   string.setTensionRange(betaMax);
   const HammeredString system(std::move(string), patch.hammer);
   InitialState rest{Vector::Zero(system.size()), Vector::Zero(system.size())};
@@ -120,7 +162,7 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
   const StepParameters params{.k = k,
                               .sigma0 = loss.sigma0,
                               .sigma1 = loss.sigma1,
-                              .epsilon = patch.epsilon,
+                              .epsilon = epsilon,
                               .trackDissipation = false};
   auto scheme = std::make_unique<SplitSav<HammeredString>>(system, params, rest);
   auto atRest = std::make_unique<SplitSav<HammeredString>>(*scheme);

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <span>
 
 #include "models/hammer.h"
@@ -21,10 +22,13 @@ struct StringPatch {
   TuneBy tuneBy = TuneBy::tension;
   double a4Hz = 440.0;
   double detuneCents = 0.0;  // from the note's equal-tempered pitch (a unison string's offset)
-  GridRule grid = GridRule::transverse;
+  GridRule grid = GridRule::twoGrid;
   double gridFactor = 1.0;
+  double tensionMargin = 1.5;  // two grids: u's grid sized for this multiple of T0 (SCHEMES §3b)
   int oversampling = 1;  // 1, 2, 4, 8 or 16
-  double epsilon = 0.0;  // gauge shift, J
+  // Gauge shift ε, J; none: kEpsilonShare of the hardest strike's energy ½ M_H v_max² where v's
+  // grid resolves the longitudinal wave, 0 where it does not (docs/string-grids.md).
+  std::optional<double> epsilon;
   double t60Low = 20.0;  // s, decay time at 0 Hz (infinite: no loss)
   double t60High = 4.0;  // s, decay time at t60HighHz
   double t60HighHz = 2000.0;
@@ -38,6 +42,12 @@ struct StringPatch {
   double guardEnergyMultiple = 4.0;  // silence when H exceeds this multiple of the injected energy
   double bendRange = 2.0;  // semitones each way that setBend() reaches; 0 keeps the finest grid
 };
+
+constexpr double kEpsilonShare = 0.1;
+// On a grid that does not resolve the longitudinal wave, the largest ε as a share of that energy.
+constexpr double kUnresolvedEpsilonShare = 0.01;
+// ½ M_H v_max²: the energy the hardest strike gives the hammer, the voice's energy scale.
+double strikeEnergyScale(const StringPatch& patch);
 
 // σ(ξ) = σ0 + σ1 ξ is the decay rate of a mode of wavenumber² ξ; two T60s fix it (data §3.4):
 // σ0 = 6.908 / T60(0 Hz), σ1 = (6.908 / T60(f) − σ0) / ξ(f), ξ(ω) from c²ξ + κ²ξ² = ω².

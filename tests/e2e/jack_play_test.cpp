@@ -405,12 +405,16 @@ class JackPlay : public ::testing::Test {
       // Pitch over the note's steady part: 0.2 s after the strike until its damper falls, when
       // it sounds alone (the score damps each key 0.5 s or more before the next strike). The
       // Hann window's peak resolves far below a cent over ≥ 0.8 s (offline: within 0.02 cent).
+      // A struck string is sharp while loud (tension modulation): the converged string
+      // (longitudinal grid, 16×) sounds A4 at velocity 80 +1.2 cents over 0.2–1.4 s, the default
+      // two grids +1.2 (docs/string-grids.md), so "in tune" is within 3 cents — a wrong rate or
+      // note is off by tens of cents or more.
       const long from = at + 9600, to = at + std::lround((n.damped - n.on - 0.01) * kRate);
       ASSERT_LT(from + 24000, to) << "note " << n.key;
       const std::span<const double> steady(x.data() + from, static_cast<size_t>(to - from));
       const double hz = 440.0 * std::pow(2.0, (n.key - 69) / 12.0);
       const double f1 = hamiltone::testing::peakFrequency(steady, hz, kRate, 30.0);
-      EXPECT_NEAR(cents(f1, hz), 0.0, 1.0) << "note " << n.key;
+      EXPECT_NEAR(cents(f1, hz), 0.0, 3.0) << "note " << n.key;
       std::printf("note %d (program %d): pitch %+.3f cents", n.key, n.program, cents(f1, hz));
       // The instrument after the program change: the paper's string has no bending stiffness,
       // so its 10th partial is harmonic (the scheme's dispersion flattens it by under 1 cent),

@@ -5,11 +5,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <vector>
 
 #include "presets/piano_scale.h"
 #include "support/energy_checks.h"
 #include "support/modal.h"
+#include "support/spectrum.h"
 
 namespace hamiltone {
 namespace {
@@ -173,9 +175,12 @@ TEST(StringVoice, DamperShortensTheDecayToItsT60) {
 
 // A gauge shift of 1e30 J drowns the energy (41) in roundoff (the ulp of 1e30 is ~1e14 J):
 // exactly the runaway the guard exists for. The output is silent and the voice reset.
-TEST(StringVoice, GuardSilencesARunawayVoiceAndCountsIt) {
+// No patch the voice accepts runs away (an unresolved grid refuses a large ε, GaugeShift… below),
+// so the guard is tripped through its other door: a gain that overflows float makes the samples
+// infinite.
+TEST(StringVoice, GuardSilencesANonFiniteVoiceAndCountsIt) {
   StringPatch patch = piano(60);
-  patch.epsilon = 1e30;
+  patch.gain = 1e300;
   StringVoice voice;
   voice.prepare(patch, 60, 48000.0);
   voice.noteOn(1.0);
@@ -235,6 +240,102 @@ TEST(StringVoice, RefusesAnInvalidPatch) {
                std::invalid_argument);
   EXPECT_THROW(voice.prepare(piano(60), 60, 1000.0), std::invalid_argument);
   EXPECT_THROW(voice.prepare(piano(60), 130, 48000.0), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace hamiltone
+
+namespace hamiltone {
+namespace {
+
+// The first `seconds` of a displacement pickup at 0.31 L, mono, struck at `velocity`.
+std::vector<double> displacement(StringPatch patch, int note, double velocity, double seconds) {
+  patch.signal = PickupSignal::displacement;
+  patch.channels = 1;
+  patch.bendRange = 0.0;
+  StringVoice voice;
+  voice.prepare(patch, note, 48000.0);
+  voice.noteOn(velocity);
+  std::vector<float> block(240), unused;
+  std::vector<double> out;
+  while (out.size() < static_cast<size_t>(seconds * 48000.0)) {
+    voice.process(block, unused);
+    out.insert(out.end(), block.begin(), block.end());
+  }
+  return out;
+}
+
+// The pitch glide in cents: the fundamental over the first 0.1 s against 0.4–0.5 s, each the
+// Hann-windowed peak (6.5 periods of C2, its second partial 20 Hz outside the main lobe).
+double glideCents(const std::vector<double>& x, double f0) {
+  const std::span<const double> all(x);
+  const double early = testing::peakFrequency(all.subspan(0, 4800), f0, 48000.0, 60.0);
+  const double late = testing::peakFrequency(all.subspan(19200, 4800), f0, 48000.0, 60.0);
+  return 1200.0 * std::log2(early / late);
+}
+
+// Issue 15's test: C2 (a wound bass string) at velocity 127 glides on the default two grids at
+// 48 kHz as it does on the converged configuration — the longitudinal grid at 16× (768 kHz,
+// measured equal to 8× within 0.01 cent) — within 15 %; the transverse grid, where v cannot
+// follow u, glides a small fraction of that (measured 0.00–0.003 of it, SCHEMES §3b). Measured:
+// converged 3.7 cents from 0.05 s to 0.45 s, two grids 3.9.
+TEST(StringVoice, TwoGridsGlideLikeTheConvergedString) {
+  const int note = 36;
+  const double f0 = equalTemperament(note);
+  StringPatch patch = piano(note);
+  const double twoGrid = glideCents(displacement(patch, note, 1.0, 0.5), f0);
+  patch.grid = GridRule::longitudinal;
+  patch.oversampling = 16;
+  const double converged = glideCents(displacement(patch, note, 1.0, 0.5), f0);
+  patch.grid = GridRule::transverse;
+  patch.oversampling = 1;
+  const double transverse = glideCents(displacement(patch, note, 1.0, 0.5), f0);
+  std::printf("glide C2 v127: two grids %.3f, converged %.3f, transverse %.3f cents\n", twoGrid,
+              converged, transverse);
+  EXPECT_GT(converged, 1.0);
+  EXPECT_NEAR(twoGrid / converged, 1.0, 0.15) << twoGrid << " against " << converged;
+  EXPECT_LT(std::abs(transverse), 0.15 * converged) << transverse;
+}
+
+// The gauge shift ε by grid: where v's grid resolves the longitudinal wave the default is a tenth
+// of the hardest strike's energy ½ M_H v_max², and any ε > 0 sounds the same (measured: 1e-3 J to
+// 1e8 J within 5e-4 of the peak); on the transverse grid it is 0 and at most a hundredth of that
+// energy, since there ψ drifts with ε until the output is noise (ε = 1 J at C3: at once).
+TEST(StringVoice, GaugeShiftDefaultsAndLimitsFollowTheGrid) {
+  StringPatch patch = piano(48);
+  const double strike = 0.5 * patch.hammer.mass * patch.velocityMax * patch.velocityMax;
+  EXPECT_DOUBLE_EQ(strikeEnergyScale(patch), strike);
+  StringVoice voice;
+  voice.prepare(patch, 48, 48000.0);
+  EXPECT_DOUBLE_EQ(voice.scheme().parameters().epsilon, kEpsilonShare * strike);
+
+  const std::vector<double> standard = displacement(patch, 48, 1.0, 0.2);
+  patch.epsilon = 1e9;
+  const std::vector<double> huge = displacement(patch, 48, 1.0, 0.2);
+  double peak = 0.0, gap = 0.0;
+  for (size_t i = 0; i < standard.size(); ++i) {
+    peak = std::max(peak, std::abs(standard[i]));
+    gap = std::max(gap, std::abs(standard[i] - huge[i]));
+  }
+  EXPECT_LE(gap, 1e-3 * peak);
+
+  patch.grid = GridRule::transverse;
+  patch.epsilon.reset();
+  voice.prepare(patch, 48, 48000.0);
+  EXPECT_EQ(voice.scheme().parameters().epsilon, 0.0);
+  patch.epsilon = kUnresolvedEpsilonShare * strike;
+  EXPECT_NO_THROW(voice.prepare(patch, 48, 48000.0));
+  patch.epsilon = 300.0;
+  try {
+    voice.prepare(patch, 48, 48000.0);
+    FAIL() << "epsilon 300 J accepted on the transverse grid";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind("epsilon_j = 300: must be between 0 and 0.0017 J on this grid", 0), 0)
+        << what;
+    EXPECT_NE(what.find("Courant number"), std::string::npos) << what;
+    EXPECT_NE(what.find("two-grid"), std::string::npos) << what;
+  }
 }
 
 }  // namespace
