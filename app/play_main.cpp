@@ -17,7 +17,7 @@
 #include "midi_input.h"
 #include "number_arguments.h"
 #include "player.h"
-#include "presets/preset_loader.h"
+#include "preset_arguments.h"
 #include "recorder.h"
 #include "usage_error.h"
 
@@ -25,7 +25,7 @@ namespace hamiltone::app {
 namespace {
 
 struct PlayArguments {
-  std::vector<std::string> presets;
+  std::vector<std::string> presets, sets;
   std::string api = "jack", device, sampleRate = "48000", buffer = "128", midiPort, virtualMidi;
   std::string record, voices;
   bool listDevices = false, quiet = false;
@@ -96,18 +96,8 @@ int play(const PlayArguments& a) {
 
   // Presets load and their voices are built here, off the audio thread; program change then only
   // switches between instruments that are ready.
-  std::vector<Instrument> instruments;
-  std::string errors;
-  const std::vector<std::string> files =
-      a.presets.empty() ? std::vector<std::string>{HAMILTONE_DEFAULT_PRESET} : a.presets;
-  for (const std::string& file : files) {
-    try {
-      instruments.push_back(loadPreset(file));
-    } catch (const PresetError& e) {
-      errors += std::string(errors.empty() ? "" : "\n") + e.what();
-    }
-  }
-  if (!errors.empty()) throw cli::UsageError("bad preset:\n" + errors);
+  std::vector<Instrument> instruments = cli::loadPresets(
+      a.presets.empty() ? std::vector<std::string>{HAMILTONE_DEFAULT_PRESET} : a.presets, a.sets);
 
   AudioOutput audio(a.api);  // AudioError: exit 2 with what exists
   const int output = audio.resolve(device);
@@ -181,6 +171,7 @@ int main(int argc, char** argv) {
                  "instrument preset (TOML); repeat it to load several, chosen by MIDI program "
                  "change (0 = the first). Default: " HAMILTONE_DEFAULT_PRESET)
       ->type_name("FILE");
+  cli::addSetOption(&app, a.sets);
   app.add_option("--api", a.api, "audio (and MIDI) API")
       ->check(CLI::IsMember({"jack", "alsa", "pulse"}))
       ->capture_default_str();

@@ -12,8 +12,8 @@
 #include "note_list.h"
 #include "number_arguments.h"
 #include "performance.h"
+#include "preset_arguments.h"
 #include "presets/parameters.h"
-#include "presets/preset_loader.h"
 #include "progress_bar.h"
 #include "usage_error.h"
 #include "util/format_number.h"
@@ -22,7 +22,7 @@ namespace hamiltone::cli {
 namespace {
 
 struct RenderArguments {
-  std::vector<std::string> presets;
+  std::vector<std::string> presets, sets;
   std::string midi, notes, out, format = "pcm24";
   std::string sampleRate = "48000", tail = "3", voices, block = "256";
   bool quiet = false, listParams = false;
@@ -54,22 +54,8 @@ int run(const RenderArguments& a) {
       a.voices.empty() ? 0 : static_cast<int>(parseInteger("--voices", a.voices, 1, 128));
 
   // Everything is read and checked before the output file is created.
-  std::vector<Instrument> instruments;
-  const std::vector<std::string> files =
-      a.presets.empty() ? std::vector<std::string>{HAMILTONE_DEFAULT_PRESET} : a.presets;
-  std::string presetErrors;
-  for (const std::string& file : files) {
-    try {
-      instruments.push_back(loadPreset(file));
-    } catch (const PresetError& e) {
-      presetErrors += e.what();
-      presetErrors += '\n';
-    }
-  }
-  if (!presetErrors.empty()) {
-    presetErrors.pop_back();
-    throw UsageError("bad preset:\n" + presetErrors);
-  }
+  std::vector<Instrument> instruments = loadPresets(
+      a.presets.empty() ? std::vector<std::string>{HAMILTONE_DEFAULT_PRESET} : a.presets, a.sets);
   std::vector<TimedMessage> messages;
   double end = 0.0;
   if (!a.midi.empty()) {
@@ -150,6 +136,7 @@ int main(int argc, char** argv) {
                  "instrument preset (TOML); repeat it to load several, chosen by MIDI program "
                  "change (0 = the first). Default: " HAMILTONE_DEFAULT_PRESET)
       ->type_name("FILE");
+  addSetOption(&app, a.sets);
   app.add_option("--midi", a.midi, "Standard MIDI File (format 0 or 1) to play")->type_name("FILE");
   app.add_option("--notes", a.notes,
                  "notes to play: NOTE[@START][:VELOCITY[:DURATION]], comma-separated, e.g. "

@@ -1,6 +1,7 @@
 // Reading a preset: the TOML syntax (toml++), every key against the parameter table (name, type,
-// range, model, per key), the bounds one parameter sets another, the per-key values between the
-// [[key]] anchors, the Instrument itself, and the voices' own checks at a few keys.
+// range, model, per key), the command line's --set over the file's keys, the bounds one parameter
+// sets another, the per-key values between the [[key]] anchors, the Instrument itself, and the
+// voices' own checks at a few keys.
 #include "presets/preset_loader.h"
 
 #include <toml++/toml.h>
@@ -33,14 +34,17 @@ constexpr size_t kMaxShown = 40;      // bytes of a name or text value quoted in
 constexpr size_t kMaxText = 200;      // bytes of a text parameter
 constexpr double kCheckRate = 48000.0;
 
+// In the file, or the nth --set (n >= 1): those come after the file, in the order given.
 struct Place {
+  int set = 0;
   long line = 1, column = 1;
   auto operator<=>(const Place&) const = default;
 };
 
 Place placeOf(const toml::source_region& region) {
   if (region.begin.line == 0) return {};
-  return {static_cast<long>(region.begin.line), static_cast<long>(region.begin.column)};
+  return {.line = static_cast<long>(region.begin.line),
+          .column = static_cast<long>(region.begin.column)};
 }
 
 // A value the file sets: a number (real, integer, note; a boolean as 1 or 0) or a word, where it
@@ -186,13 +190,13 @@ std::optional<Unsafe> unsafeForToml(std::string_view text) {
     while (i + n < text.size() && text[i + n] == quote) ++n;
     return n;
   };
-  Place at{1, 0};
+  Place at{.line = 1, .column = 0};
   size_t i = text.starts_with("\xEF\xBB\xBF") ? 3 : 0;  // a byte-order mark, which toml++ skips
   // Moves to byte j, counting lines and characters (not UTF-8 continuation bytes) on the way.
   auto moveTo = [&](size_t j) {
     for (; i < j && i < text.size(); ++i) {
       if (text[i] == '\n')
-        at = {at.line + 1, 0};
+        at = {.line = at.line + 1, .column = 0};
       else if ((byte(i) & 0xC0) != 0x80)
         ++at.column;
     }
@@ -254,6 +258,22 @@ std::optional<Unsafe> unsafeForToml(std::string_view text) {
     }
   }
   return std::nullopt;
+}
+
+// A --set VALUE as the one value of the table's key "x": what `x = VALUE` in a file would be; or
+// the text itself as a string where that is not one value (a bare word: longitudinal, C4) or where
+// `p` wants a word (a choice or text) and VALUE reads as another type — so that the row's own check
+// says what is valid, and nothing VALUE holds can add a key.
+toml::table overrideValue(const Parameter* p, const std::string& text) {
+  const std::string document = "x = " + text;
+  const bool wantsWord = p && (p->type == ParameterType::choice || p->type == ParameterType::text);
+  if (!unsafeForToml(document)) try {
+      toml::table parsed = toml::parse(document);
+      const toml::node* x = parsed.get("x");
+      if (parsed.size() == 1 && x && (x->is_string() || !wantsWord)) return parsed;
+    } catch (const toml::parse_error&) {
+    }
+  return toml::table{{"x", text}};
 }
 
 // The sections of the table ("string", "hammer", …), not counting "key" (the anchors).
@@ -358,6 +378,8 @@ class Loader {
   void readSection(std::string_view section, const toml::table& table, Place at);
   void readAnchors(const toml::node& node, Place at);
   void readAnchor(const toml::table& table, size_t ordinal);
+  void readOverrides(const std::vector<PresetOverride>& overrides);
+  std::string said(const std::string& name, const std::string& shown, Place at) const;
   void entry(std::string name, const toml::node& value, Place at, Settings& into,
              const std::string& label);
   std::optional<Setting> convert(const Parameter& p, const toml::node& value, Place at,
@@ -369,6 +391,7 @@ class Loader {
   Instrument build() const;
   void checkVoices(const Instrument& instrument);
   void voiceError(std::string_view message, int note);
+  std::string withOverrides(Place blamed) const;
 
   const Parameter& row(std::string_view name) const;
   const Setting* setting(std::string_view name) const;
@@ -387,6 +410,7 @@ class Loader {
   std::set<std::string_view> invalid_;  // parameters set somewhere to an invalid value
   std::vector<Anchor> anchors_;         // by note once read
   std::set<std::pair<Place, std::string_view>> voiceReported_;  // (setting, parameter)
+  std::vector<std::string> overrides_;  // "--set NAME=VALUE" for each, as messages show it
 };
 
 void Loader::error(Place at, std::string message) {
@@ -403,9 +427,16 @@ void Loader::fail() {
   const size_t total = errors_.size() + dropped_;
   const size_t shown = total > kMaxLines ? kMaxLines - 1 : total;
   std::vector<std::string> lines;
-  for (size_t i = 0; i < shown; ++i)
-    lines.push_back(source_ + ":" + std::to_string(errors_[i].first.line) + ":" +
-                    std::to_string(errors_[i].first.column) + ": " + errors_[i].second);
+  for (size_t i = 0; i < shown; ++i) {
+    const Place& at = errors_[i].first;
+    std::string line = source_;
+    if (at.set == 0)  // a --set's line names it instead
+      line.append(":")
+          .append(std::to_string(at.line))
+          .append(":")
+          .append(std::to_string(at.column));
+    lines.push_back(line.append(": ").append(errors_[i].second));
+  }
   if (shown < total)
     lines.push_back(source_ + ": … and " + std::to_string(total - shown) + " more errors");
   throw PresetError(std::move(lines));
@@ -428,8 +459,9 @@ Instrument Loader::load(std::string_view text, const PresetOptions& options) {
   }
   readModel(root);
   readRoot(root);
+  checkAnchors();  // the file's own: a narrower range from --set keeps the anchors beyond it
+  readOverrides(options.overrides);
   checkRequired();
-  checkAnchors();
   checkBounds();
   throwIfErrors();
   Instrument instrument = build();
@@ -541,18 +573,45 @@ void Loader::readAnchor(const toml::table& table, size_t ordinal) {
   if (valid) anchors_.push_back(std::move(anchor));
 }
 
+// Each --set after the file, as a key of the file: a valid one replaces the file's value, and a
+// per-key one the anchors' values too, so that it holds at every key.
+void Loader::readOverrides(const std::vector<PresetOverride>& overrides) {
+  for (const PresetOverride& o : overrides) {
+    overrides_.push_back("--set " + clip(o.name, false) + "=" + clip(o.value, false));
+    const Place at{.set = static_cast<int>(overrides_.size())};
+    if (o.name == "model") {
+      error(at, overrides_.back() +
+                    ": the model cannot be set; it decides what the file's other "
+                    "keys mean (load a preset of that model instead)");
+      continue;
+    }
+    const toml::table value = overrideValue(findParameter(o.name), o.value);
+    Settings valid;
+    entry(o.name, *value.get("x"), at, valid, "");
+    for (auto& [name, setting] : valid) {
+      settings_[name] = std::move(setting);
+      for (Anchor& a : anchors_) a.values.erase(name);
+    }
+  }
+}
+
+// How a message names a value: "hammer.mass_kg = 0.1" from the file, or its "--set NAME=VALUE".
+std::string Loader::said(const std::string& name, const std::string& shown, Place at) const {
+  return at.set > 0 ? overrides_[static_cast<size_t>(at.set) - 1] : name + " = " + shown;
+}
+
 void Loader::entry(std::string name, const toml::node& value, Place at, Settings& into,
                    const std::string& label) {
   const std::string shownName = (label.empty() ? "" : label + ".") + clip(name, false);
+  const std::string head = said(shownName, show(value), at);
   const Parameter* any = findParameter(name);
   if (!any || sectionOf(name) == "key") {
-    if (value.is_table()) {
+    if (value.is_table() && at.set == 0) {
       std::vector<std::string_view> tables = sections();
       tables.push_back("key");
       error(at, "[" + shownName + "]: unknown table" + suggestion(name, tables, "[", "]"));
     } else {
-      error(at, shownName + " = " + show(value) + ": unknown key" +
-                    suggestion(name, keyNames(!label.empty())));
+      error(at, head + ": unknown key" + suggestion(name, keyNames(!label.empty())));
     }
     return;
   }
@@ -560,7 +619,7 @@ void Loader::entry(std::string name, const toml::node& value, Place at, Settings
   const Parameter* p = model_ ? findParameter(name, *model_) : any;
   if (!p) {
     error(at,
-          shownName + " = " + show(value) + ": " +
+          head + ": " +
               std::string(modelName(*model_ == InstrumentModel::string ? InstrumentModel::plate
                                                                        : InstrumentModel::string)) +
               " model only; this preset's model is \"" + std::string(modelName(*model_)) + "\"");
@@ -568,7 +627,7 @@ void Loader::entry(std::string name, const toml::node& value, Place at, Settings
   }
   if (!label.empty() && !p->perKey) {
     const std::string_view section = sectionOf(p->name);
-    error(at, shownName + " = " + show(value) + ": not per-key; set it " +
+    error(at, head + ": not per-key; set it " +
                   (section.empty() ? std::string("at the top level")
                                    : "in [" + std::string(section) + "]"));
     return;
@@ -583,7 +642,7 @@ std::optional<Setting> Loader::convert(const Parameter& p, const toml::node& val
                                        const std::string& label) {
   Setting s{.place = at, .shown = show(value)};
   auto refuse = [&](const std::string& what) {
-    error(at, label + " = " + s.shown + ": " + what);
+    error(at, said(label, s.shown, at) + ": " + what);
     return std::nullopt;
   };
   switch (p.type) {
@@ -687,8 +746,14 @@ void Loader::checkBound(const Parameter& p, const Parameter& other, bool upper) 
   const bool perKey = anchored(p) || anchored(other);
   const int lo = static_cast<int>(number("lowest_note"));
   const int hi = perKey ? static_cast<int>(number("highest_note")) : lo;
-  // The one set in the file is blamed; with both set, the bounded one.
-  const bool blameP = setting(p.name) || anchored(p) || (!setting(other.name) && !anchored(other));
+  // The one set in the file is blamed; with both set, the bounded one — unless only the other was
+  // given by --set, which is then what changed.
+  auto bySet = [&](const Parameter& q) {
+    const Setting* s = setting(q.name);
+    return s && s->place.set > 0;
+  };
+  const bool blameP = (bySet(p) || !bySet(other)) && (setting(p.name) || anchored(p) ||
+                                                      (!setting(other.name) && !anchored(other)));
   // The anchors' own notes first, so that an anchor's value is reported at its note.
   std::vector<int> notes;
   if (perKey)
@@ -784,7 +849,8 @@ Blame Loader::blame(const Parameter& p, int note, bool sayNote) const {
                             : p.type == ParameterType::choice  ? "\"" + word(p.name) + "\""
                             : p.type == ParameterType::boolean ? std::string(p.defaultText)
                                                                : approximate(number(p.name));
-  return {s ? s->place : Place{}, std::string(p.name) + " = " + value + (sayNote ? at : "")};
+  const Place place = s ? s->place : Place{};
+  return {place, said(std::string(p.name), value, place) + (sayNote ? at : "")};
 }
 
 Instrument Loader::build() const {
@@ -905,7 +971,8 @@ void Loader::checkVoices(const Instrument& instrument) {
     return;
   }
   for (int note = lo; note <= hi; note += 12) notes.insert(note);
-  for (const Anchor& a : anchors_) notes.insert(a.note);
+  for (const Anchor& a : anchors_)
+    if (a.note >= lo && a.note <= hi) notes.insert(a.note);  // a --set may narrow the range
   // The patches the synthesizer plays: the outermost unison strings carry the detune extremes.
   for (int note : notes) try {
       const int unisons = instrument.keys[note - lo].unisons;
@@ -935,15 +1002,24 @@ void Loader::voiceError(std::string_view message, int note) {
     const Setting* edge = note == number("lowest_note")    ? setting("lowest_note")
                           : note == number("highest_note") ? setting("highest_note")
                                                            : nullptr;
-    error(edge ? edge->place : Place{},
-          noteName(note) + " (" + std::to_string(note) + "): " + std::string(message));
+    error(edge ? edge->place : Place{}, noteName(note) + " (" + std::to_string(note) +
+                                            "): " + std::string(message) + withOverrides({}));
     return;
   }
   const Blame b = blame(row(found->parameter), note, true);
   if (!voiceReported_.emplace(b.place, found->parameter).second) return;
   const std::string_view rest =
       found->keep || colon == std::string_view::npos ? message : message.substr(colon + 2);
-  error(b.place, b.text + ": " + std::string(rest));
+  error(b.place, b.text + ": " + std::string(rest) + withOverrides(b.place));
+}
+
+// A voice refuses what the file and the --set give together: a line that blames the file (or no
+// one setting) names every --set too, since one of them may be the cause.
+std::string Loader::withOverrides(Place blamed) const {
+  if (blamed.set > 0 || overrides_.empty()) return "";
+  std::string out;
+  for (const std::string& o : overrides_) out += (out.empty() ? " (with " : ", ") + o;
+  return out + ")";
 }
 
 }  // namespace
@@ -956,7 +1032,21 @@ PresetError::PresetError(std::vector<std::string> messages)
       }()),
       lines(std::move(messages)) {}
 
-Instrument loadPreset(const std::filesystem::path& file) {
+std::optional<PresetOverride> parseOverride(std::string_view argument) {
+  const size_t equals = argument.find('=');
+  if (equals == std::string_view::npos) return std::nullopt;
+  auto trim = [](std::string_view s) {
+    const size_t first = s.find_first_not_of(" \t");
+    if (first == std::string_view::npos) return std::string_view{};
+    return s.substr(first, s.find_last_not_of(" \t") - first + 1);
+  };
+  PresetOverride o{std::string(trim(argument.substr(0, equals))),
+                   std::string(trim(argument.substr(equals + 1)))};
+  if (o.name.empty()) return std::nullopt;
+  return o;
+}
+
+Instrument loadPreset(const std::filesystem::path& file, const PresetOptions& options) {
   const std::string name = file.string();
   std::error_code error;
   if (!std::filesystem::exists(file, error))
@@ -969,7 +1059,7 @@ Instrument loadPreset(const std::filesystem::path& file) {
   in.read(text.data(), static_cast<std::streamsize>(text.size()));
   if (in.bad()) throw PresetError({name + ": cannot read the file"});
   text.resize(static_cast<size_t>(in.gcount()));
-  return parsePreset(text, name);
+  return parsePreset(text, name, options);
 }
 
 Instrument parsePreset(std::string_view text, const std::string& sourceName,

@@ -1,10 +1,13 @@
 // libFuzzer target for the preset loader: any text must either load or be refused with a
 // PresetError. Any other exception, a crash, a hang or a sanitizer report is a finding. The
-// voices' own check is left out: it prepares real voices, milliseconds per input.
+// voices' own check is left out: it prepares real voices, milliseconds per input. After a NUL
+// byte, each line is a --set NAME=VALUE over the text before it (its VALUE goes to toml++ too).
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <string_view>
+#include <vector>
 
 #include "presets/preset_loader.h"
 
@@ -16,9 +19,19 @@ bool positive(double x) { return std::isfinite(x) && x > 0.0; }
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace hamiltone;
-  const std::string_view text(reinterpret_cast<const char*>(data), size);
+  std::string_view text(reinterpret_cast<const char*>(data), size);
+  std::vector<PresetOverride> overrides;
+  if (const std::size_t nul = text.rfind('\0'); nul != std::string_view::npos) {
+    for (std::string_view sets = text.substr(nul + 1); !sets.empty();) {
+      const std::size_t end = std::min(sets.find('\n'), sets.size());
+      if (auto o = parseOverride(sets.substr(0, end))) overrides.push_back(std::move(*o));
+      sets.remove_prefix(std::min(end + 1, sets.size()));
+    }
+    text = text.substr(0, nul);
+  }
   try {
-    const Instrument instrument = parsePreset(text, "fuzz.toml", {.checkVoices = false});
+    const Instrument instrument =
+        parsePreset(text, "fuzz.toml", {.checkVoices = false, .overrides = overrides});
     // What the loader promises of every preset it accepts.
     if (instrument.lowestNote < 0 || instrument.highestNote > 127 ||
         instrument.lowestNote > instrument.highestNote)

@@ -21,8 +21,10 @@
 namespace hamiltone {
 namespace {
 
+using ::testing::AllOf;
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 std::string sourcePath(const std::string& relative) {
   return std::string(HAMILTONE_SOURCE_DIR) + "/" + relative;
@@ -351,6 +353,182 @@ TEST(PresetLoader, CapsTheErrorLines) {
   const std::vector<std::string> lines = errorsOfText(text);
   ASSERT_EQ(lines.size(), 100u);
   EXPECT_EQ(lines.back(), "test.toml: … and 201 more errors");
+}
+
+// --- --set NAME=VALUE over the file (PresetOptions::overrides) ----------------------------------
+
+std::vector<std::string> errorsWith(const std::string& text, std::vector<PresetOverride> set) {
+  return errorsOfText(text, {.overrides = std::move(set)});
+}
+
+TEST(PresetOverrides, ArgumentSplitsAtTheFirstEquals) {
+  auto split = [](std::string_view argument) {
+    const auto o = parseOverride(argument);
+    return o ? o->name + "|" + o->value : std::string("none");
+  };
+  EXPECT_EQ(split("scheme.grid_rule=longitudinal"), "scheme.grid_rule|longitudinal");
+  EXPECT_EQ(split(" name = \"a=b\" "), "name|\"a=b\"");
+  EXPECT_EQ(split("gain_dB="), "gain_dB|");  // the loader says what the value should be
+  EXPECT_EQ(split("scheme.oversampling"), "none");
+  EXPECT_EQ(split("=16"), "none");
+}
+
+// The grand piano as the bundled file has it, and with the scheme and a hammer setting changed on
+// the command line: every key is built with the new values and nothing else moves.
+TEST(PresetOverrides, ChangeWhatIsBuilt) {
+  const std::string piano = sourcePath("presets/grand-piano.toml");
+  const Instrument file = loadPreset(piano);
+  ASSERT_EQ(file.keys[0].patch.grid, GridRule::transverse);  // else the test shows nothing
+  ASSERT_EQ(file.keys[0].patch.oversampling, 1);
+  ASSERT_NE(file.keys[0].patch.velocityMax, 4.0);
+  const Instrument set = loadPreset(piano, {.overrides = {{"scheme.grid_rule", "longitudinal"},
+                                                          {"scheme.oversampling", "16"},
+                                                          {"hammer.velocity_max_m_s", "4"},
+                                                          {"name", "Piano B"}}});
+  EXPECT_EQ(set.name, "Piano B");
+  ASSERT_EQ(set.keys.size(), file.keys.size());
+  for (size_t i = 0; i < set.keys.size(); ++i) {
+    const StringPatch& p = set.keys[i].patch;
+    EXPECT_EQ(p.grid, GridRule::longitudinal) << i;
+    EXPECT_EQ(p.oversampling, 16) << i;
+    EXPECT_EQ(p.velocityMax, 4.0) << i;
+    EXPECT_EQ(p.string.tension, file.keys[i].patch.string.tension) << i;
+    EXPECT_EQ(p.hammer.mass, file.keys[i].patch.hammer.mass) << i;
+  }
+}
+
+// A word may go without quotes where the row wants a word (choice, text) or a note name; a TOML
+// value is read as the file would read it, and quotes still work.
+TEST(PresetOverrides, ValuesAreWrittenAsInAFileOrAsBareWords) {
+  const Instrument i = parsePreset(kStringHead, "test.toml",
+                                   {.overrides = {{"scheme.grid_rule", "\"longitudinal\""},
+                                                  {"string.tune_by", "length"},
+                                                  {"lowest_note", "C#2"},
+                                                  {"highest_note", "40"},
+                                                  {"name", "2024"},
+                                                  {"loss.t60_low_s", "inf"},
+                                                  {"string.bending_stiffness", "false"}}});
+  EXPECT_EQ(i.keys[0].patch.grid, GridRule::longitudinal);
+  EXPECT_EQ(i.keys[0].patch.tuneBy, TuneBy::length);
+  EXPECT_EQ(i.lowestNote, 37);
+  EXPECT_EQ(i.highestNote, 40);
+  EXPECT_EQ(i.name, "2024");  // text: the number is taken as its word
+  EXPECT_EQ(i.keys[0].patch.t60Low, INFINITY);
+  EXPECT_EQ(i.keys[0].patch.string.inertia, 0.0);
+}
+
+// A per-key parameter set on the command line holds at every key: the [[key]] anchors that set it
+// give way, those that set other parameters still shape them.
+TEST(PresetOverrides, PerKeyOverrideBeatsTheAnchors) {
+  const std::string text = kStringHead +
+                           "[string]\nlength_m = 1.5\n"
+                           "[[key]]\nnote = \"C2\"\nstring.length_m = 2.0\n"
+                           "string.detune_cents = 0\nstring.unisons = 1\n"
+                           "[[key]]\nnote = \"C3\"\nstring.detune_cents = 10\n"
+                           "[[key]]\nnote = \"C4\"\nstring.length_m = 0.5\nstring.unisons = 3\n";
+  const Instrument file = parsePreset(text, "test.toml");
+  ASSERT_NEAR(file.keys[48 - 36].patch.string.length, 1.0, 1e-15);  // the anchors' own value
+  const Instrument i = parsePreset(
+      text, "test.toml", {.overrides = {{"string.length_m", "1.2"}, {"string.unisons", "2"}}});
+  for (const StringKey& key : i.keys) {
+    EXPECT_EQ(key.patch.string.length, 1.2);
+    EXPECT_EQ(key.unisons, 2);
+  }
+  EXPECT_NEAR(i.keys[42 - 36].detuneCents, 5.0, 1e-15);  // still between its anchors
+}
+
+// A file's anchors must lie in its own range; a narrower range set on the command line builds
+// those keys only, with the values the anchors beyond it give them.
+TEST(PresetOverrides, NarrowerRangeKeepsTheAnchorsBeyondIt) {
+  const std::string anchors =
+      "[[key]]\nnote = \"C2\"\nstring.length_m = 2.0\n"
+      "[[key]]\nnote = \"C4\"\nstring.length_m = 0.5\n";
+  EXPECT_THAT(
+      errorsOfText("model = \"string\"\nlowest_note = \"C3\"\nhighest_note = \"D3\"\n" + anchors),
+      ElementsAre(HasSubstr("key[C2].note = \"C2\": outside lowest_note … highest_note"),
+                  HasSubstr("key[C4].note = \"C4\": outside lowest_note … highest_note")));
+  const Instrument i = parsePreset(kStringHead + anchors, "test.toml",
+                                   {.overrides = {{"lowest_note", "C3"}, {"highest_note", "D3"}}});
+  ASSERT_EQ(i.keys.size(), 3u);
+  EXPECT_NEAR(i.keys[0].patch.string.length, 1.0, 1e-15);  // geometric mean of 2 and 0.5
+}
+
+// Each kind of bad value gets the file's message, the --set named in place of LINE:COL.
+TEST(PresetOverrides, BadOverridesAreRefusedNamingTheSet) {
+  const struct {
+    PresetOverride set;
+    const char* line;
+  } cases[] = {
+      {{"scheme.oversampling", "3"},
+       "test.toml: --set scheme.oversampling=3: expected one of 1, 2, 4, 8, 16"},
+      {{"string.unisons", "4"}, "test.toml: --set string.unisons=4: out of range; expected 1 … 3"},
+      {{"hammer.mass_kg", "heavy"}, "test.toml: --set hammer.mass_kg=heavy: expected a number"},
+      {{"gain_dB", "nan"}, "test.toml: --set gain_dB=nan: not a finite number"},
+      {{"scheme.grid_rule", "diagonal"},
+       "test.toml: --set scheme.grid_rule=diagonal: expected \"transverse\" or \"longitudinal\""},
+      {{"string.bending_stiffness", "yes"},
+       "test.toml: --set string.bending_stiffness=yes: expected true or false"},
+      {{"lowest_note", "H2"},
+       "test.toml: --set lowest_note=H2: expected a MIDI note 0 … 127 or a name like \"C4\""},
+      {{"scheme.oversampeling", "16"},
+       "test.toml: --set scheme.oversampeling=16: unknown key; did you mean scheme.oversampling?"},
+      {{"plate.lx_m", "1"},
+       "test.toml: --set plate.lx_m=1: plate model only; this preset's model is \"string\""},
+      {{"key.note", "C3"}, "test.toml: --set key.note=C3: unknown key"},
+      {{"model", "plate"},
+       "test.toml: --set model=plate: the model cannot be set; it decides what the file's other "
+       "keys mean (load a preset of that model instead)"},
+      // One value only: what follows a newline is part of the text, not another key.
+      {{"gain_dB", "1\nmodel = \"plate\""},
+       "test.toml: --set gain_dB=1?model = \"plate\": expected a number"},
+  };
+  for (const auto& c : cases)
+    EXPECT_THAT(errorsWith(kStringHead, {c.set}), ElementsAre(c.line)) << c.set.name;
+}
+
+// The bound one parameter sets another blames the --set that broke it, whichever side it is on.
+TEST(PresetOverrides, CrossFieldBoundsBlameTheSet) {
+  const std::string text = kStringHead + "[loss]\nt60_low_s = 5\nt60_high_s = 1\n";
+  EXPECT_THAT(errorsWith(text, {{"loss.t60_high_s", "50"}}),
+              ElementsAre("test.toml: --set loss.t60_high_s=50: out of range; expected 0.01 … 5 "
+                          "(loss.t60_low_s)"));
+  EXPECT_THAT(errorsWith(text, {{"loss.t60_low_s", "0.5"}}),
+              ElementsAre("test.toml: --set loss.t60_low_s=0.5: out of range; expected at least 1 "
+                          "(loss.t60_high_s)"));
+}
+
+// The file's own errors come first, in file order, then the --set ones in the order given.
+TEST(PresetOverrides, ErrorsListTheFileThenEachSetInOrder) {
+  EXPECT_THAT(errorsWith(kStringHead + "bogus = 1\n", {{"polyphony", "0"}, {"gain_dB", "x"}}),
+              ElementsAre("test.toml:4:1: bogus = 1: unknown key",
+                          "test.toml: --set polyphony=0: out of range; expected 1 … 128",
+                          "test.toml: --set gain_dB=x: expected a number"));
+}
+
+// A grid the string cannot have (the longitudinal rule at the base rate makes h longer than the
+// treble strings) is the voices' refusal: each line names the setting the voice names and every
+// --set it was built with.
+TEST(PresetOverrides, VoiceCheckNamesTheSets) {
+  const std::string piano = sourcePath("presets/grand-piano.toml");
+  std::vector<std::string> lines;
+  try {
+    loadPreset(piano, {.overrides = {{"scheme.grid_rule", "longitudinal"}}});
+  } catch (const PresetError& e) {
+    lines = e.lines;
+  }
+  ASSERT_FALSE(lines.empty());
+  for (const std::string& line : lines) {
+    EXPECT_THAT(line, HasSubstr("shorter than two grid spacings"));
+    EXPECT_THAT(line, HasSubstr("(with --set scheme.grid_rule=longitudinal)"));
+  }
+  // The same grid at 16 times the rate is fine.
+  EXPECT_NO_THROW(loadPreset(
+      piano, {.overrides = {{"scheme.grid_rule", "longitudinal"}, {"scheme.oversampling", "16"}}}));
+  // Where the voice names the overridden parameter itself, the line is the --set's, once.
+  EXPECT_THAT(errorsWith(kStringHead, {{"string.length_m", "0.02"}}),
+              ElementsAre(AllOf(HasSubstr("test.toml: --set string.length_m=0.02 at C2: shorter "
+                                          "than two grid spacings"),
+                                Not(HasSubstr("(with")))));
 }
 
 TEST(PresetParameters, DefaultsSatisfyTheirOwnRanges) {

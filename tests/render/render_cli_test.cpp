@@ -14,16 +14,14 @@
 #include <string>
 #include <vector>
 
+#include "support/run_command.h"
 #include "support/spectrum.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Result {
-  int exitCode;
-  std::string err;
-};
+using Result = hamiltone::testing::CommandResult;
 
 struct Wav {
   SF_INFO info{};
@@ -42,15 +40,8 @@ class RenderCli : public ::testing::Test {
   void TearDown() override { fs::remove_all(dir_); }
 
   Result run(const std::string& args) {
-    const fs::path err = dir_ / "stderr";
-    const std::string cmd = std::string(HAMILTONE_RENDER) + " " + args + " >/dev/null 2>" +
-                            err.string() + " </dev/null";
-    const int status = std::system(cmd.c_str());
-    std::ifstream in(err);
-    std::stringstream s;
-    s << in.rdbuf();
-    fs::remove(err);
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, s.str()};
+    return hamiltone::testing::runCommand(std::string(HAMILTONE_RENDER) + " " + args,
+                                          dir_ / "stderr");
   }
 
   static Wav read(const fs::path& path) {
@@ -154,6 +145,39 @@ TEST_F(RenderCli, RefusesBadInputAndWritesNothing) {
   const Result r = run(c3 + " --notes C3 -o /proc/hamiltone/out.wav");
   EXPECT_EQ(r.exitCode, 2) << r.err;
   EXPECT_NE(r.err.find("-o"), std::string::npos) << r.err;
+}
+
+// --set over every preset, heard in the file: A4 of the grand piano tuned to a4_Hz = 432 (the
+// preset tunes by tension) sounds at 432 Hz, within the cent the tuning test allows.
+TEST_F(RenderCli, SetChangesWhatIsRendered) {
+  const Result r = run("--preset " + preset("grand-piano") +
+                       " --set a4_Hz=432 --notes A4:30:2 --tail 0 --quiet -o " + wav());
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const Wav w = read(wav());
+  std::vector<double> left;
+  for (sf_count_t i = 24000; i < w.info.frames; ++i) left.push_back(w.samples[2 * i]);
+  const double measured = hamiltone::testing::peakFrequency(left, 432.0, 48000.0);
+  EXPECT_NEAR(1200.0 * std::log2(measured / 432.0), 0.0, 1.0);
+}
+
+TEST_F(RenderCli, RefusesABadSetNamingItAndWritesNothing) {
+  const std::string c3 = " --preset " + preset("paper-c3-string") + " --notes C3";
+  expectRefused(
+      c3 + " --set scheme.oversampling=3",
+      "paper-c3-string.toml: --set scheme.oversampling=3: expected one of 1, 2, 4, 8, 16");
+  expectRefused(c3 + " --set scheme.grid_rule=diagonal",
+                "--set scheme.grid_rule=diagonal: expected \"transverse\" or \"longitudinal\"");
+  expectRefused(c3 + " --set hammer.velocity_max_m_s=30",
+                "--set hammer.velocity_max_m_s=30: out of range; expected 0 … 20");
+  expectRefused(c3 + " --set scheme.oversampeling=16", "did you mean scheme.oversampling?");
+  expectRefused(c3 + " --set plate.lx_m=1", "--set plate.lx_m=1: plate model only");
+  expectRefused(c3 + " --set foo", "--set foo: expected NAME=VALUE");
+  expectRefused(c3 + " --set =16", "--set =16: expected NAME=VALUE");
+  // A voice the overrides make impossible: the grand piano's treble strings on the longitudinal
+  // grid at the base rate.
+  expectRefused(" --preset " + preset("grand-piano") +
+                    " --notes C3 --set scheme.grid_rule=longitudinal --set scheme.oversampling=1",
+                "(with --set scheme.grid_rule=longitudinal, --set scheme.oversampling=1)");
 }
 
 TEST_F(RenderCli, ListsTheParameterTable) {

@@ -1,0 +1,58 @@
+// --preset and --set for both players: the overrides are the loader's (PresetOptions::overrides);
+// this reads them off the command line and gathers every preset's errors into one UsageError.
+#include "preset_arguments.h"
+
+#include "presets/parameters.h"
+#include "usage_error.h"
+
+namespace hamiltone::cli {
+
+void addSetOption(CLI::App* app, std::vector<std::string>& sets) {
+  app->add_option("--set", sets,
+                  "set a preset parameter in every loaded preset, over its file; repeatable. NAME "
+                  "as hamiltone-render --list-params lists it, VALUE as in a file (3.5, inf, "
+                  "true, \"C4\"; a word may go unquoted: scheme.grid_rule=longitudinal). A "
+                  "per-key parameter set here holds at every key, over the file's [[key]] "
+                  "anchors; a narrower lowest_note/highest_note builds those keys only.")
+      ->type_name("NAME=VALUE")
+      ->allow_extra_args(false);
+}
+
+std::vector<PresetOverride> parseSets(const std::vector<std::string>& sets) {
+  std::vector<PresetOverride> out;
+  for (const std::string& set : sets) {
+    if (auto o = parseOverride(set)) {
+      out.push_back(std::move(*o));
+      continue;
+    }
+    const std::string name = set.substr(0, set.find('='));
+    // A parameter's name alone: the value is what is missing.
+    if (findParameter(name))
+      throw UsageError("--set " + set + ": expected " + name +
+                       "=VALUE (hamiltone-render --list-params gives its type and range)");
+    throw UsageError("--set " + set +
+                     ": expected NAME=VALUE, e.g. --set scheme.grid_rule=longitudinal or --set "
+                     "hammer.velocity_max_m_s=4 (hamiltone-render --list-params lists every NAME, "
+                     "its type and range)");
+  }
+  return out;
+}
+
+std::vector<Instrument> loadPresets(const std::vector<std::string>& files,
+                                    const std::vector<std::string>& sets) {
+  PresetOptions options;
+  options.overrides = parseSets(sets);
+  std::vector<Instrument> instruments;
+  std::string errors;
+  for (const std::string& file : files) {
+    try {
+      instruments.push_back(loadPreset(file, options));
+    } catch (const PresetError& e) {
+      errors += std::string(errors.empty() ? "" : "\n") + e.what();
+    }
+  }
+  if (!errors.empty()) throw UsageError("bad preset:\n" + errors);
+  return instruments;
+}
+
+}  // namespace hamiltone::cli

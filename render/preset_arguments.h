@@ -1,0 +1,24 @@
+// --preset FILE and --set NAME=VALUE as hamiltone-render and hamiltone-play both take them: one
+// help text, one reading of the arguments, every preset loaded with the same overrides.
+#pragma once
+
+#include <CLI/App.hpp>
+#include <string>
+#include <vector>
+
+#include "presets/preset_loader.h"
+
+namespace hamiltone::cli {
+
+// Registers the repeatable --set NAME=VALUE, its help saying what wins over what.
+void addSetOption(CLI::App* app, std::vector<std::string>& sets);
+
+// The --set arguments, in order; UsageError for the first without NAME=, saying what is valid.
+std::vector<PresetOverride> parseSets(const std::vector<std::string>& sets);
+
+// Every file loaded with every --set over it (PresetOptions::overrides); UsageError "bad preset:"
+// with every error line of every file, or of a malformed --set.
+std::vector<Instrument> loadPresets(const std::vector<std::string>& files,
+                                    const std::vector<std::string>& sets);
+
+}  // namespace hamiltone::cli

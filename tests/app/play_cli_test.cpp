@@ -1,0 +1,55 @@
+// hamiltone-play's command line where no audio device is needed: presets and every --set are read
+// before any device is opened, so a bad --set is refused (exit 2, one message naming it) and a
+// good one gets as far as the audio API — here a JACK server that does not exist.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <string>
+#include <utility>
+
+#include "support/run_command.h"
+
+namespace {
+
+using hamiltone::testing::CommandResult;
+
+// hamiltone-play --api jack ARGS with a JACK server name of its own that no server has, so a
+// developer's JACK server is never met and none is started.
+CommandResult play(const std::string& args) {
+  const std::string pid = std::to_string(::getpid());
+  return hamiltone::testing::runCommand(
+      "JACK_DEFAULT_SERVER=hamiltone-none-" + pid + " JACK_NO_START_SERVER=1 timeout 60 " +
+          HAMILTONE_PLAY + " --api jack " + args,
+      std::filesystem::temp_directory_path() / ("hamiltone-play-cli-" + pid + ".err"));
+}
+
+std::string preset(const char* name) {
+  return std::string(HAMILTONE_SOURCE_DIR) + "/presets/" + name + ".toml";
+}
+
+TEST(PlayCli, RefusesABadSetBeforeOpeningAnyDevice) {
+  const std::string c3 = "--preset " + preset("paper-c3-string");
+  for (const auto& [args, mention] :
+       {std::pair<std::string, std::string>{
+            c3 + " --set scheme.oversampling=3",
+            "paper-c3-string.toml: --set scheme.oversampling=3: expected one of 1, 2, 4, 8, 16"},
+        {c3 + " --set scheme.oversampeling=16", "did you mean scheme.oversampling?"},
+        {c3 + " --set foo", "--set foo: expected NAME=VALUE"}}) {
+    const CommandResult r = play(args);
+    EXPECT_EQ(r.exitCode, 2) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find(mention), std::string::npos) << args << "\n" << r.err;
+    EXPECT_EQ(r.err.find("audio"), std::string::npos) << args << "\n" << r.err;
+  }
+}
+
+// Past the presets: the refusal is the audio API's, not a preset's.
+TEST(PlayCli, AcceptsAGoodSetAndGoesOnToTheAudioDevice) {
+  const CommandResult r = play("--preset " + preset("paper-c3-string") +
+                               " --set scheme.grid_rule=longitudinal --set scheme.oversampling=16");
+  EXPECT_EQ(r.exitCode, 2) << r.err;
+  EXPECT_NE(r.err.find("no audio output device for API jack"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("--set"), std::string::npos) << r.err;
+}
+
+}  // namespace

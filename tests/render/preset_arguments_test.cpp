@@ -1,0 +1,73 @@
+// --preset and --set as both players read them: a --set without NAME= is refused saying what is
+// valid, every preset gets every --set, and every preset's refusal is gathered into one error.
+#include "preset_arguments.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "usage_error.h"
+
+namespace {
+
+using hamiltone::Instrument;
+using hamiltone::cli::loadPresets;
+using hamiltone::cli::parseSets;
+using hamiltone::cli::UsageError;
+
+std::string preset(const char* name) {
+  return std::string(HAMILTONE_SOURCE_DIR) + "/presets/" + name + ".toml";
+}
+
+// The message of the UsageError loading `files` with `sets` raises ("" if none).
+std::string errorOf(const std::vector<std::string>& files, const std::vector<std::string>& sets) {
+  try {
+    loadPresets(files, sets);
+  } catch (const UsageError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(PresetArguments, SetWithoutNameAndEqualsSaysWhatIsValid) {
+  for (const char* bad : {"foo", "=3", ""}) {
+    const std::string message = errorOf({preset("paper-c3-string")}, {"gain_dB=-3", bad});
+    EXPECT_EQ(message.find("--set " + std::string(bad) +
+                           ": expected NAME=VALUE, e.g. --set "
+                           "scheme.grid_rule=longitudinal"),
+              0u)
+        << message;
+  }
+  EXPECT_EQ(errorOf({preset("paper-c3-string")}, {"scheme.oversampling"}),
+            "--set scheme.oversampling: expected scheme.oversampling=VALUE (hamiltone-render "
+            "--list-params gives its type and range)");
+  ASSERT_EQ(parseSets({"a=1", "b = x=y"}).size(), 2u);
+  EXPECT_EQ(parseSets({"b = x=y"})[0].value, "x=y");
+}
+
+TEST(PresetArguments, EveryPresetGetsEverySet) {
+  const std::vector<Instrument> instruments =
+      loadPresets({preset("paper-c3-string"), preset("grand-piano")},
+                  {"hammer.velocity_max_m_s=4", "gain_dB=-7"});
+  ASSERT_EQ(instruments.size(), 2u);
+  for (const Instrument& i : instruments) {
+    EXPECT_EQ(i.gainDb, -7.0) << i.name;
+    for (const auto& key : i.keys) EXPECT_EQ(key.patch.velocityMax, 4.0) << i.name;
+  }
+}
+
+// A string-only --set refuses the plate preset and only it; the message lists each file's lines.
+TEST(PresetArguments, EveryPresetsRefusalIsGathered) {
+  const std::string plate = preset("steel-plate");
+  EXPECT_EQ(errorOf({preset("paper-c3-string"), plate, plate},
+                    {"scheme.grid_rule=longitudinal", "scheme.oversampling=16"}),
+            "bad preset:\n" + plate +
+                ": --set scheme.grid_rule=longitudinal: string model only; this preset's model "
+                "is \"plate\"\n" +
+                plate +
+                ": --set scheme.grid_rule=longitudinal: string model only; this preset's model "
+                "is \"plate\"");
+}
+
+}  // namespace
