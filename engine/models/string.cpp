@@ -60,7 +60,8 @@ NonlinearString::NonlinearString(const StringPhysics& p, StringGrid grid)
   inverseMass_.resize(nu + nv);
   inverseMass_.head(nu).setConstant(1.0 / (p.linearDensity() * h_));
   inverseMass_.tail(nv).setConstant(1.0 / (p.linearDensity() * hv_));
-  for (Vector* w : {&work1_, &work2_, &work3_}) w->setZero(grid.transverse);
+  for (Vector* w : {&work1_, &work2_}) w->setZero(grid.transverse);
+  work3_.setZero(grid.transverse + 1);
   for (Vector* w : {&cell1_, &cell2_}) w->setZero(grid.longitudinal);
 }
 
@@ -209,14 +210,6 @@ double NonlinearString::singleGridGradient(const Vector& q, Vector& grad) const 
 
 namespace {
 
-// ζ_l = (u_l − u_{l−1}) / h on the M fine segments, u = 0 beyond both ends; u[j] is point j + 1.
-void transverseStrains(const double* u, Eigen::Index m, double invH, double* zeta) {
-  zeta[0] = u[0] * invH;
-  zeta[m - 1] = -u[m - 2] * invH;
-#pragma omp simd
-  for (Eigen::Index l = 1; l < m - 1; ++l) zeta[l] = (u[l] - u[l - 1]) * invH;
-}
-
 // η_J = (v_J − v_{J−1}) / h_v on the Mv coarse cells, v = 0 beyond both ends.
 void longitudinalStrains(const double* v, Eigen::Index mv, double invHv, double* eta) {
   if (mv == 1) {
@@ -228,18 +221,29 @@ void longitudinalStrains(const double* v, Eigen::Index mv, double invHv, double*
   for (Eigen::Index j = 1; j < mv - 1; ++j) eta[j] = (v[j] - v[j - 1]) * invHv;
 }
 
-// One coarse cell: Σ_{l∈J} (s_l − 1) over its r fine segments (ζ given), storing 1/s_l and
-// returning Σ 1/s_l in `sumInverse`.
-inline double cellExcess(const double* zeta, double eta, int r, double* inverseStretch,
-                         double& sumInverse) {
-  double excess = 0.0, inverse = 0.0;
+// u with its fixed ends, up[0] = up[M] = 0, so that ζ_l = (up[l+1] − up[l]) / h on every segment.
+void paddedTransverse(const double* u, Eigen::Index m, double* up) {
+  up[0] = up[m] = 0.0;
+  std::copy(u, u + m - 1, up + 1);
+}
+
+// One coarse cell of r fine segments starting at `up` (padded u) with coarse strain η: returns
+// Σ (s_l − 1) and sets Σ 1/s_l, and ζ_l/s_l into `zetaOverS`; s_l = sqrt((1 + η)² + ζ_l²).
+// s − 1 = (2η + η² + ζ²)/(s + 1) has no cancellation at small strain, and one division serves
+// both quotients: t = 1/(s (s + 1)).
+[[gnu::always_inline]] inline double cellStretch(const double* up, double invH, double eta, int r, double* zetaOverS,
+                          double& sumInverse) {
   const double a = (1.0 + eta) * (1.0 + eta), b = 2.0 * eta + eta * eta;
+  double excess = 0.0, inverse = 0.0;
 #pragma omp simd reduction(+ : excess, inverse)
   for (int i = 0; i < r; ++i) {
-    const double stretch = std::sqrt(a + zeta[i] * zeta[i]);
-    excess += (b + zeta[i] * zeta[i]) / (stretch + 1.0);  // s − 1 without cancellation
-    inverseStretch[i] = 1.0 / stretch;
-    inverse += inverseStretch[i];
+    const double zeta = (up[i + 1] - up[i]) * invH, z2 = zeta * zeta;
+    const double stretch = std::sqrt(a + z2);
+    const double t = 1.0 / (stretch * (stretch + 1.0));
+    const double inv = (stretch + 1.0) * t;
+    excess += (b + z2) * stretch * t;
+    inverse += inv;
+    zetaOverS[i] = zeta * inv;
   }
   sumInverse = inverse;
   return excess;
@@ -249,15 +253,16 @@ inline double cellExcess(const double* zeta, double eta, int r, double* inverseS
 
 // SCHEMES §3b: ε_J = (1/r) Σ_{l∈J} (s_l − 1), V' = (EA − T0)/2 Σ_J h_v ε_J².
 double NonlinearString::twoGridPotential(const Vector& q) const {
-  const Eigen::Index mv = grid_.longitudinal;
-  double* zeta = work1_.data();
+  const Eigen::Index m = segments_, mv = grid_.longitudinal;
+  double* up = work3_.data();
   double* eta = cell1_.data();
-  transverseStrains(q.data(), segments_, 1.0 / h_, zeta);
-  longitudinalStrains(q.data() + (segments_ - 1), mv, 1.0 / hv_, eta);
+  const double invR = 1.0 / ratio_;
+  paddedTransverse(q.data(), m, up);
+  longitudinalStrains(q.data() + (m - 1), mv, 1.0 / hv_, eta);
   double sum = 0.0, unused;
   for (Eigen::Index j = 0; j < mv; ++j) {
-    const double strain = cellExcess(zeta + j * ratio_, eta[j], ratio_, work2_.data(), unused) /
-                          ratio_;
+    const double strain =
+        cellStretch(up + j * ratio_, 1.0 / h_, eta[j], ratio_, work1_.data(), unused) * invR;
     sum += strain * strain;
   }
   return 0.5 * hv_ * (physics_.young * physics_.area - physics_.tension) * sum;
@@ -269,29 +274,29 @@ double NonlinearString::twoGridPotential(const Vector& q) const {
 double NonlinearString::twoGridGradient(const Vector& q, Vector& grad) const {
   const Eigen::Index m = segments_, mv = grid_.longitudinal;
   const double invH = 1.0 / h_, invHv = 1.0 / hv_;
-  const double c = (physics_.young * physics_.area - physics_.tension) * h_;
-  double* zeta = work1_.data();  // ζ_l, then ∂V'/∂ζ_l in place
-  double* inverseStretch = work2_.data();
+  const double c = (physics_.young * physics_.area - physics_.tension) * h_, invR = 1.0 / ratio_;
+  double* wz = work1_.data();  // ζ_l/s_l, then ∂V'/∂ζ_l
+  double* up = work3_.data();
   double* eta = cell1_.data();
   double* we = cell2_.data();  // ∂V'/∂η_J
-  transverseStrains(q.data(), m, invH, zeta);
+  paddedTransverse(q.data(), m, up);
   longitudinalStrains(q.data() + (m - 1), mv, invHv, eta);
   double sum = 0.0;
   for (Eigen::Index j = 0; j < mv; ++j) {
-    double* z = zeta + j * ratio_;
-    double* inv = inverseStretch + j * ratio_;
+    double* cell = wz + j * ratio_;
     double sumInverse;
-    const double strain = cellExcess(z, eta[j], ratio_, inv, sumInverse) / ratio_;
+    const double strain =
+        cellStretch(up + j * ratio_, invH, eta[j], ratio_, cell, sumInverse) * invR;
     sum += strain * strain;
     const double w = c * strain;
-#pragma omp simd
-    for (int i = 0; i < ratio_; ++i) z[i] *= w * inv[i];
     we[j] = w * (1.0 + eta[j]) * sumInverse;
+#pragma omp simd
+    for (int i = 0; i < ratio_; ++i) cell[i] *= w;
   }
   double* gu = grad.data();
   double* gv = grad.data() + (m - 1);
 #pragma omp simd
-  for (Eigen::Index j = 0; j < m - 1; ++j) gu[j] = (zeta[j] - zeta[j + 1]) * invH;
+  for (Eigen::Index j = 0; j < m - 1; ++j) gu[j] = (wz[j] - wz[j + 1]) * invH;
   for (Eigen::Index j = 0; j < mv - 1; ++j) gv[j] = (we[j] - we[j + 1]) * invHv;
   return 0.5 * hv_ * (physics_.young * physics_.area - physics_.tension) * sum;
 }

@@ -89,7 +89,8 @@ class NonlinearString {
   double h_, hv_;         // h_u, h_v
   Vector inverseMass_;
   double tensionScale_ = 1.0, tensionScaleMax_ = 1.0;
-  // Work of the stencils and the gradient: per fine segment (size Mu) and per coarse cell (Mv).
+  // Work of the stencils and the gradient: per fine segment (size Mu; work3_ holds u padded with
+  // its fixed ends, Mu + 1) and per coarse cell (Mv).
   mutable Vector work1_, work2_, work3_, cell1_, cell2_;
 };
 
