@@ -42,11 +42,13 @@ struct Note {
   const char* name;
 };
 constexpr Note kNotes[] = {{21, "A0"}, {48, "C3"}, {84, "C6"}};
-constexpr GridRule kGrids[] = {GridRule::transverse, GridRule::longitudinal};
+constexpr GridRule kGrids[] = {GridRule::twoGrid, GridRule::transverse, GridRule::longitudinal};
 constexpr int kOversampling[] = {1, 4};
 
 const char* gridName(GridRule g) {
-  return g == GridRule::transverse ? "transverse" : "longitudinal";
+  return g == GridRule::twoGrid      ? "two-grid"
+         : g == GridRule::transverse ? "transverse"
+                                     : "longitudinal";
 }
 
 std::string voiceName(const Note& note, GridRule grid, int oversampling, bool lossless) {
@@ -233,6 +235,15 @@ void printVoices(const RecordingReporter& reporter) {
     std::printf(
         "Goal: C3 voice, transverse grid, os 1, <= 2 ns per unknown per step: %.3f ns, %s\n",
         perUnknown, verdict(perUnknown <= 2.0));
+  }
+  // Issue 15: a voice on the two grids costs at most 0.7 of one on the transverse grid.
+  for (const Note& note : kNotes) {
+    const auto* two = reporter.find(voiceName(note, GridRule::twoGrid, 1, false));
+    const auto* one = reporter.find(voiceName(note, GridRule::transverse, 1, false));
+    if (two == nullptr || one == nullptr) continue;
+    const double ratio = two->seconds / one->seconds;
+    std::printf("Goal: %s voice, two-grid / transverse cost <= 0.7: %.2f, %s\n", note.name, ratio,
+                verdict(ratio <= 0.7));
   }
 }
 

@@ -1,11 +1,13 @@
 // Cost of the synthesizer playing the grand-piano preset: chords of N held middle-register keys
 // (every unison string of each key), as a real-time callback would ask for them. The counter
 // "x_realtime" is seconds of audio per second of CPU: above 1 the chord plays in real time on one
-// core. The summary names the largest N that does.
+// core. The summary names the largest N that does. Beside it, the cost of one grand-piano key
+// across the keyboard on each string grid rule, and the ratio of the two-grid to the transverse.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
 #include <cstdio>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -48,8 +50,46 @@ void chord(benchmark::State& state) {
     state.counters["strings"] += piano.keys[kLowestKey + i - piano.lowestNote].unisons;
 }
 
+// Every 6th key from A0 to C8 (15 keys, all unison strings) struck together and held: the time per
+// block divided by the keys is the cost of an average grand-piano key (ns per sample of audio).
+constexpr const char* kGridRules[] = {"two-grid", "transverse"};
+
+void keyboard(benchmark::State& state) {
+  const char* rule = kGridRules[state.range(0)];
+  constexpr int kBlockSize = 256;
+  Instrument piano = loadPreset(HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml",
+                                {.overrides = {{"scheme.grid_rule", rule}}});
+  std::vector<bool> notes(128, false);
+  std::vector<SynthEvent> strike;
+  for (int key = piano.lowestNote; key <= piano.highestNote; key += 6) {
+    notes[key] = true;
+    strike.push_back({0, {0x90, static_cast<std::uint8_t>(key), 90}});
+  }
+  const int keys = static_cast<int>(strike.size());
+  Synth synth;
+  synth.prepare({piano}, {.sampleRate = kSampleRate, .maxBlock = kBlockSize, .notes = notes});
+  synth.setPolyphony(keys);
+  std::vector<float> left(kBlockSize), right(kBlockSize);
+  const int restrike = static_cast<int>(kRestrikeS * kSampleRate / kBlockSize);
+  int blocks = 0;
+  for (auto _ : state) {
+    const bool now = blocks++ % restrike == 0;
+    synth.process(left, right,
+                  now ? std::span<const SynthEvent>(strike) : std::span<const SynthEvent>());
+    benchmark::DoNotOptimize(left.data());
+  }
+  if (synth.activeVoices() != keys) state.SkipWithError("not every key kept sounding");
+  state.SetLabel(rule);
+  state.counters["keys"] = keys;
+  state.counters["t/key/sample"] =
+      benchmark::Counter(static_cast<double>(state.iterations()) * kBlockSize * keys,
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
 }  // namespace
 }  // namespace hamiltone
+
+BENCHMARK(hamiltone::keyboard)->ArgName("rule")->DenseRange(0, 1)->Unit(benchmark::kMillisecond);
 
 BENCHMARK(hamiltone::chord)
     ->ArgNames({"voices", "block"})
@@ -58,13 +98,20 @@ BENCHMARK(hamiltone::chord)
 
 namespace {
 
-// The console table, and the largest chord (its "voices:N" argument) at or above real time.
+// The console table, the largest chord (its "voices:N" argument) at or above real time, and the
+// cost of a key on each grid rule.
 class ChordReporter : public benchmark::ConsoleReporter {
  public:
   ChordReporter() : ConsoleReporter(OO_Tabular) {}
   void ReportRuns(const std::vector<Run>& runs) override {
     ConsoleReporter::ReportRuns(runs);
     for (const Run& run : runs) {
+      // A single run's figure, or with repetitions their median.
+      const auto perKey = run.counters.find("t/key/sample");
+      const bool median = run.run_type == Run::RT_Aggregate && run.aggregate_name == "median";
+      if (!run.error_occurred && perKey != run.counters.end() && !run.report_label.empty() &&
+          (median || (run.run_type == Run::RT_Iteration && run.repetitions <= 1)))
+        keyCost[run.report_label] = perKey->second.value;
       const auto speed = run.counters.find("x_realtime");
       if (run.error_occurred || speed == run.counters.end() || speed->second.value < 1.0) continue;
       const std::string& args = run.run_name.args;  // "voices:16/block:256"
@@ -72,6 +119,7 @@ class ChordReporter : public benchmark::ConsoleReporter {
     }
   }
   int largest = 0;
+  std::map<std::string, double> keyCost;  // seconds per sample of audio, by grid rule
 };
 
 }  // namespace
@@ -82,6 +130,12 @@ int main(int argc, char** argv) {
   ChordReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
   const int largest = reporter.largest;
+  auto& cost = reporter.keyCost;
+  if (cost.count("two-grid") && cost.count("transverse"))
+    std::printf("\ngrand-piano key, every 6th from A0: two-grid %.0f ns per sample, transverse %.0f "
+                "(ratio %.2f; goal <= 0.7)\n",
+                1e9 * cost["two-grid"], 1e9 * cost["transverse"],
+                cost["two-grid"] / cost["transverse"]);
   std::printf("\nlargest grand-piano chord (keys from C3) rendered faster than real time on one "
               "core: %d keys (goal: 32)\n", largest);
   benchmark::Shutdown();
