@@ -378,7 +378,7 @@ TEST(PresetOverrides, ArgumentSplitsAtTheFirstEquals) {
 TEST(PresetOverrides, ChangeWhatIsBuilt) {
   const std::string piano = sourcePath("presets/grand-piano.toml");
   const Instrument file = loadPreset(piano);
-  ASSERT_EQ(file.keys[0].patch.grid, GridRule::transverse);  // else the test shows nothing
+  ASSERT_EQ(file.keys[0].patch.grid, GridRule::twoGrid);  // else the test shows nothing
   ASSERT_EQ(file.keys[0].patch.oversampling, 1);
   ASSERT_NE(file.keys[0].patch.velocityMax, 4.0);
   const Instrument set = loadPreset(piano, {.overrides = {{"scheme.grid_rule", "longitudinal"},
@@ -465,7 +465,8 @@ TEST(PresetOverrides, BadOverridesAreRefusedNamingTheSet) {
       {{"hammer.mass_kg", "heavy"}, "test.toml: --set hammer.mass_kg=heavy: expected a number"},
       {{"gain_dB", "nan"}, "test.toml: --set gain_dB=nan: not a finite number"},
       {{"scheme.grid_rule", "diagonal"},
-       "test.toml: --set scheme.grid_rule=diagonal: expected \"transverse\" or \"longitudinal\""},
+       "test.toml: --set scheme.grid_rule=diagonal: expected one of \"two-grid\", "
+       "\"transverse\", \"longitudinal\""},
       {{"string.bending_stiffness", "yes"},
        "test.toml: --set string.bending_stiffness=yes: expected true or false"},
       {{"lowest_note", "H2"},

@@ -166,7 +166,8 @@ TEST_F(RenderCli, RefusesABadSetNamingItAndWritesNothing) {
       c3 + " --set scheme.oversampling=3",
       "paper-c3-string.toml: --set scheme.oversampling=3: expected one of 1, 2, 4, 8, 16");
   expectRefused(c3 + " --set scheme.grid_rule=diagonal",
-                "--set scheme.grid_rule=diagonal: expected \"transverse\" or \"longitudinal\"");
+                "--set scheme.grid_rule=diagonal: expected one of \"two-grid\", \"transverse\", "
+                "\"longitudinal\"");
   expectRefused(c3 + " --set hammer.velocity_max_m_s=30",
                 "--set hammer.velocity_max_m_s=30: out of range; expected 0 … 20");
   expectRefused(c3 + " --set scheme.oversampeling=16", "did you mean scheme.oversampling?");
