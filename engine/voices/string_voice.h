@@ -104,6 +104,7 @@ class StringVoice {
   int guardEvents_ = 0;
   int separatedSteps_ = 0;
   bool active_ = false, released_ = false, struck_ = false;
+  bool parked_ = true;  // the back-check holds the hammer (until the next strike)
 };
 
 }  // namespace hamiltone
