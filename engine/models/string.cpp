@@ -31,6 +31,19 @@ void secondDifference(const double* a, double* out, Eigen::Index n, double c) {
   out[n - 1] = c * (a[n - 2] - 2.0 * a[n - 1]);
 }
 
+// c D2 (a − b) in one pass, the difference taken as it is read; `out` aliases neither.
+void secondDifferenceOfDifference(const double* a, const double* b, double* out, Eigen::Index n,
+                                  double c) {
+  auto d = [&](Eigen::Index j) { return a[j] - b[j]; };
+  if (n == 1) {
+    out[0] = -2.0 * c * d(0);
+    return;
+  }
+  out[0] = c * (d(1) - 2.0 * d(0));
+  for (Eigen::Index j = 1; j + 1 < n; ++j) out[j] = c * (d(j - 1) - 2.0 * d(j) + d(j + 1));
+  out[n - 1] = c * (d(n - 2) - 2.0 * d(n - 1));
+}
+
 }  // namespace
 
 NonlinearString::NonlinearString(const StringPhysics& p, StringGrid grid)
@@ -120,20 +133,12 @@ double NonlinearString::lossOperatorEigenvalueMax() const {
 }
 
 void NonlinearString::applyLossOperator(const Vector& a, const Vector& b, Vector& out) const {
-  const Eigen::Index n = size(), nu = segments_ - 1;
-  out.head(n) = a.head(n) - b.head(n);
-  double* d = work1_.data();
+  const Eigen::Index nu = segments_ - 1, nv = grid_.longitudinal - 1;
   // M (−D2) = −ρA h D2 on each grid, with its own h.
-  const struct {
-    Eigen::Index start, count;
-    double h;
-  } blocks[] = {{0, nu, h_}, {nu, n - nu, hv_}};
-  for (const auto& block : blocks) {
-    if (block.count == 0) continue;
-    std::copy(out.data() + block.start, out.data() + block.start + block.count, d);
-    secondDifference(d, out.data() + block.start, block.count,
-                     -physics_.linearDensity() / block.h);
-  }
+  const double rhoA = physics_.linearDensity();
+  secondDifferenceOfDifference(a.data(), b.data(), out.data(), nu, -rhoA / h_);
+  if (nv > 0)
+    secondDifferenceOfDifference(a.data() + nu, b.data() + nu, out.data() + nu, nv, -rhoA / hv_);
 }
 
 namespace {

@@ -60,7 +60,8 @@ class NonlinearString {
   double splitPotential(const Vector& q) const;
   double splitGradient(const Vector& q, Vector& grad) const;
 
-  // M(−L)(a − b), L = D2 on u and on v: the operator of the frequency-dependent loss σ1.
+  // M(−L)(a − b), L = D2 on u and on v: the operator of the frequency-dependent loss σ1. `out`
+  // must not be `a` or `b`.
   void applyLossOperator(const Vector& a, const Vector& b, Vector& out) const;
   double lossOperatorEigenvalueMax() const;  // λmax(−D2) < 4/h²
 

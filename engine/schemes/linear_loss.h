@@ -12,7 +12,8 @@
 namespace hamiltone {
 
 // A model with a frequency-dependent loss says which operator it acts through: C = M(−L) >= 0,
-// L its Laplacian, applied to a difference of two states (a − b), and λmax(−L).
+// L its Laplacian, applied to a difference of two states (a − b) into a third vector, and
+// λmax(−L).
 template <class S>
 concept HasLossOperator = requires(const S& s, const Vector& a, Vector& out) {
   s.applyLossOperator(a, a, out);
@@ -78,8 +79,7 @@ class LinearLoss {
     if constexpr (HasLossOperator<S>) {
       if (sigma1_ > 0.0) {
         diff_ = minv.cwiseProduct(start.p);
-        cq_.setZero();
-        s.applyLossOperator(diff_, cq_, cq_);  // C v0
+        s.applyLossOperator(diff_, Vector::Zero(diff_.size()), cq_);  // C v0
         q1 -= sigma1_ * k * k * minv.cwiseProduct(cq_);
         cq_.setZero();
       }

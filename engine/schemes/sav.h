@@ -170,8 +170,11 @@ class SavScheme {
     // extra_ = 2σ1k C(q^n − q^{n−1}) − k² f.
     const double* cq = nullptr;
     if constexpr (lossy) {
-      extra_ =
-          (2.0 * params_.sigma1 * k) * loss_.frequencyForce(system_, curr_, prev_) - kk * force_;
+      const Vector& lossForce = loss_.frequencyForce(system_, curr_, prev_);
+      if (forced_)
+        extra_ = (2.0 * params_.sigma1 * k) * lossForce - kk * force_;
+      else
+        extra_ = (2.0 * params_.sigma1 * k) * lossForce;
       cq = extra_.data();
     }
 
