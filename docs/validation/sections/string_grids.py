@@ -137,8 +137,9 @@ def pitch_figure(ctx, runs, keys):
     fig.tight_layout()
     return ctx.figure(fig, FIGURES[0],
                       "Pitch of the fundamental of one unison string at velocity 127, on the three "
-                      "grid rules (Hann frames every 10 ms, 0.1 s long, 0.2 s for A0, zero-padded "
-                      "×16, parabolic peak), in cents from the linear scheme's fundamental.")
+                      "grid rules (the displacement at the pickup; Hann frames every 10 ms, 0.1 s "
+                      "long, 0.2 s for A0, zero-padded ×16, parabolic peak), in cents from the "
+                      "linear scheme's fundamental.")
 
 
 def spectra_figure(ctx, runs, partials, midi):
@@ -155,7 +156,9 @@ def spectra_figure(ctx, runs, partials, midi):
             ax.axvline(f, color="C2", ls="--", lw=0.8,
                        label="longitudinal modes m·√(E/ρ)/2L" if i == 0 else None)
         ax.set_title(f"{LABELS[config]}: between partials {r['phantom']:.1f} dB, first "
-                     f"longitudinal band {r['long']:.1f} dB re peak", fontsize=9)
+                     f"longitudinal band {r['long']:.1f} dB re peak"
+                     + (f" (a partial within ±{1.5 * BAND:g} Hz)" if r["crowded"] else ""),
+                     fontsize=9)
         ax.set_ylabel("dB re peak")
         ax.set_ylim(-110, 8)
     axes[0].legend(loc="upper right")
