@@ -4,9 +4,9 @@
 # --quick: shorter runs (about 2 minutes; exits non-zero if a basic check fails, e.g. the energy
 #   drift of an energy-conserving scheme above 1e-10). --out DIR: write DIR/validation.md and
 #   DIR/figures/ instead of docs/. --build-dir DIR: use that tree's hamiltone-sim and
-#   hamiltone-render (and bench/hamiltone_bench_references, if built) as they are (no install, no
-#   build); the ctest uses it. Without it the script installs what is missing and builds the
-#   Release tree build/release, like scripts/demo.sh.
+#   hamiltone-render (and bench/hamiltone_bench_references and bench/hamiltone_validate_grids, if
+#   built) as they are (no install, no build); the ctest uses it. Without it the script installs
+#   what is missing and builds the Release tree build/release, like scripts/demo.sh.
 # Exit 77 (ctest's skip code) with --build-dir when Debian's python3-matplotlib is missing.
 set -euo pipefail
 
@@ -37,10 +37,12 @@ mkdir -p "$out" 2>/dev/null && [ -w "$out" ] || usage "--out $out: cannot create
 python=/usr/bin/python3
 if [ -z "$build_dir" ]; then
   ./scripts/install-deps.sh
-  # The benchmark program hamiltone_bench_references times BDZ Figs. 7 and 10.
+  # The benchmark program hamiltone_bench_references times BDZ Figs. 7 and 10;
+  # hamiltone_validate_grids renders and times the string's grid rules.
   cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release \
         -DHAMILTONE_BUILD_TESTS=OFF -DHAMILTONE_BUILD_BENCH=ON >/dev/null
-  cmake --build build/release --target hamiltone-sim hamiltone-render hamiltone_bench_references
+  cmake --build build/release --target hamiltone-sim hamiltone-render hamiltone_bench_references \
+        hamiltone_validate_grids
   build_dir=build/release
 elif ! "$python" -c 'import matplotlib, numpy' 2>/dev/null; then
   echo "validation.sh: $python has no matplotlib/numpy (scripts/install-deps.sh installs them); skipped"
@@ -49,6 +51,8 @@ fi
 
 sim="$build_dir/render/hamiltone-sim"
 render="$build_dir/render/hamiltone-render"
+# Optional: a tree built without the benchmarks lacks it, and its section says so.
+grids="$build_dir/bench/hamiltone_validate_grids"
 for b in "$sim" "$render"; do
   [ -x "$b" ] || { echo "validation.sh: $b is not built" >&2; exit 1; }
 done
@@ -59,7 +63,8 @@ work=$(mktemp -d "$out/.validation-XXXXXX")
 trap 'rm -rf "$work"' EXIT
 start=$SECONDS
 status=0
-"$python" docs/validation/report.py --sim "$sim" --render "$render" --out "$work" "${quick[@]}" ||
+"$python" docs/validation/report.py --sim "$sim" --render "$render" --grids "$grids" \
+  --out "$work" "${quick[@]}" ||
   status=$?
 [ -f "$work/validation.md" ] || { echo "validation.sh: the report was not written" >&2; exit 1; }
 mkdir -p "$out/figures"

@@ -20,10 +20,11 @@ class Context:
 
     sim, render: paths of hamiltone-sim and hamiltone-render; work: a scratch directory of the
     section's own (deleted afterwards); figures: where PNGs go (the report links them as
-    figures/NAME); quick: the reduced run; source: the repository root."""
+    figures/NAME); quick: the reduced run; source: the repository root; grids: the path of
+    bench/hamiltone_validate_grids, or None where the benchmarks were not built."""
 
-    def __init__(self, name, sim, render, work, figures, quick, source):
-        self.name, self.sim, self.render = name, sim, render
+    def __init__(self, name, sim, render, work, figures, quick, source, grids=None):
+        self.name, self.sim, self.render, self.grids = name, sim, render, grids
         self.work, self.figures, self.quick, self.source = work, figures, quick, source
         self.saved = []      # figure file names this section wrote
         self.skipped = []    # (figure name, reason) of figures that could not be made
@@ -42,6 +43,8 @@ class Context:
                 a = "build/release/render/hamiltone-sim"
             elif a == self.render:
                 a = "build/release/render/hamiltone-render"
+            elif a == self.grids:
+                a = "build/release/bench/hamiltone_validate_grids"
             elif a.startswith(self.work + os.sep):
                 a = os.path.relpath(a, self.work)
             elif a.startswith(self.source + os.sep):
@@ -125,6 +128,33 @@ def read_wav(path):
     else:
         raise ValueError(f"{path}: {8 * width}-bit samples are not read here")
     return x.reshape(-1, channels).mean(axis=1), rate
+
+
+def spectrum(x, rate, start, length, pad=4):
+    """Magnitude spectrum of x[start : start + length] seconds, Hann window, zero-padded."""
+    a, n = int(start * rate), int(length * rate)
+    seg = x[a:a + n] * np.hanning(len(x[a:a + n]))
+    size = pad * len(seg)
+    return np.fft.rfftfreq(size, 1 / rate), np.abs(np.fft.rfft(seg, size))
+
+
+def peak(freqs, mag, lo, hi):
+    """The largest peak in [lo, hi], refined by a parabola through log magnitudes."""
+    sel = np.nonzero((freqs >= lo) & (freqs <= hi))[0]
+    i = sel[np.argmax(mag[sel])]
+    a, b, c = np.log(mag[i - 1:i + 2] + 1e-300)
+    shift = 0.5 * (a - c) / (a - 2 * b + c) if a - 2 * b + c != 0 else 0.0
+    return freqs[i] + shift * (freqs[1] - freqs[0]), mag[i]
+
+
+def pitch_track(x, rate, lo, hi, frame=0.2, hop=0.025, stop=None):
+    """The strongest peak in [lo, hi] Hz over time: Hann frames of `frame` s every `hop` s,
+    starting before `stop` s (default: every frame that fits in x), zero-padded ×16, parabolic
+    peak. Returns (frame centres, Hz)."""
+    fits = (len(x) - int(frame * rate)) / rate + 1e-9
+    times = np.arange(0.0, fits if stop is None else min(stop, fits), hop)
+    pitch = [peak(*spectrum(x, rate, t, frame, pad=16), lo, hi)[0] for t in times]
+    return times + frame / 2, np.array(pitch)
 
 
 def relative_deviation(energy):

@@ -3,7 +3,8 @@
 module of docs/validation/sections/ in order and joins their markdown under a header.
 
 Run through scripts/validation.sh, which builds the binaries and passes their paths:
-    /usr/bin/python3 docs/validation/report.py --sim SIM --render RENDER --out DIR [--quick]
+    /usr/bin/python3 docs/validation/report.py --sim SIM --render RENDER [--grids GRIDS] --out DIR
+                                               [--quick]
 
 A section is a module `sections/NAME.py` with
     TITLE = "..."                  # the heading of its part of the report
@@ -38,6 +39,7 @@ SECTIONS = [
     "marazzato_figs",       # Marazzato et al. Figs. 6, 12, 16 (fpu --slow-fast, wave-inhomogeneous)
     # ------------------------------------------------------------------------------------------
     "instrument",    # the synthesizer: piano brightness, inharmonicity, pitch glide, gong
+    "string_grids",  # the string's grid rules on the piano: glide, phantom partials, cost
 ]
 
 
@@ -63,12 +65,14 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sim", required=True)
     parser.add_argument("--render", required=True)
+    parser.add_argument("--grids", help="bench/hamiltone_validate_grids (built with the benchmarks)")
     parser.add_argument("--out", required=True, help="writes OUT/validation.md and OUT/figures/")
     parser.add_argument("--quick", action="store_true", help="short runs (the ctest)")
     parser.add_argument("--only", help="comma-separated section names (development)")
     args = parser.parse_args()
     source = os.path.dirname(os.path.dirname(HERE))
     sim, render = os.path.abspath(args.sim), os.path.abspath(args.render)
+    grids = os.path.abspath(args.grids) if args.grids else None
     figures = os.path.join(args.out, "figures")
     os.makedirs(figures, exist_ok=True)
     only = set(args.only.split(",")) if args.only else None
@@ -84,7 +88,7 @@ def main():
             module = importlib.import_module("sections." + name)
             work = os.path.join(scratch, name)
             os.makedirs(work)
-            ctx = Context(name, sim, render, work, figures, args.quick, source)
+            ctx = Context(name, sim, render, work, figures, args.quick, source, grids)
             print(f"validation: {name} ...", flush=True)
             start = time.monotonic()
             try:

@@ -11,7 +11,7 @@ import tomllib
 import matplotlib.pyplot as plt
 import numpy as np
 
-from common import code, fmt, read_csv, read_wav
+from common import code, fmt, peak, pitch_track, read_csv, read_wav, spectrum
 
 TITLE = "The instrument: piano and gong"
 FIGURES = ["instrument_piano_velocity", "instrument_piano_partials", "instrument_piano_glide",
@@ -29,23 +29,6 @@ def render(ctx, name, notes, preset=None, tail=0.5):
     args += ["--notes", notes, "--tail", tail, "--format", "pcm24", "--quiet", "-o", path]
     ctx.run(args)
     return read_wav(path)
-
-
-def spectrum(x, rate, start, length, pad=4):
-    """Magnitude spectrum of x[start : start + length] seconds, Hann window, zero-padded."""
-    a, n = int(start * rate), int(length * rate)
-    seg = x[a:a + n] * np.hanning(len(x[a:a + n]))
-    size = pad * len(seg)
-    return np.fft.rfftfreq(size, 1 / rate), np.abs(np.fft.rfft(seg, size))
-
-
-def peak(freqs, mag, lo, hi):
-    """The largest peak in [lo, hi], refined by a parabola through log magnitudes."""
-    sel = np.nonzero((freqs >= lo) & (freqs <= hi))[0]
-    i = sel[np.argmax(mag[sel])]
-    a, b, c = np.log(mag[i - 1:i + 2] + 1e-300)
-    shift = 0.5 * (a - c) / (a - 2 * b + c) if a - 2 * b + c != 0 else 0.0
-    return freqs[i] + shift * (freqs[1] - freqs[0]), mag[i]
 
 
 def spectrogram(ax, x, rate, top, title):
@@ -111,14 +94,6 @@ def longitudinal_variant(ctx, lowest, oversampling):
     with open(path, "w") as f:
         f.write(head + "".join(kept))
     return path, ", ".join(f"`{k} = {v}`" for k, v in changes.items())
-
-
-def pitch_track(x, rate, lo, hi, end=2.0):
-    """Fundamental over time: 0.2 s Hann frames every 25 ms starting before `end` s, zero-padded
-    ×16, parabolic peak. Returns (frame centres, Hz)."""
-    times = np.arange(0.0, min(len(x) / rate - 0.25, end), 0.025)
-    pitch = [peak(*spectrum(x, rate, t, 0.2, pad=16), lo, hi)[0] for t in times]
-    return times + 0.1, np.array(pitch)
 
 
 def note_glide(t, p):
@@ -204,10 +179,11 @@ def glide(ctx, f0, notes, rate):
     variant, changed = longitudinal_variant(ctx, anchor["note"], 2)
     fixed, _ = render(ctx, "c3_v127_longitudinal", "C3:127:3.0", preset=variant)
     commands = [ctx.commands[-2], ctx.commands[-1]]
-    tracks = {"shipped, velocity 127": pitch_track(loud, rate, 0.8 * f0, 1.2 * f0),
+    band = (0.8 * f0, 1.2 * f0)
+    tracks = {"shipped, velocity 127": pitch_track(loud, rate, *band, stop=2.0),
               # Its key is released at 2 s: the last frame ends there.
-              "shipped, velocity 30": pitch_track(notes[30][0], rate, 0.8 * f0, 1.2 * f0, 1.81),
-              "longitudinal grid, velocity 127": pitch_track(fixed, rate, 0.8 * f0, 1.2 * f0)}
+              "shipped, velocity 30": pitch_track(notes[30][0], rate, *band, stop=1.81),
+              "longitudinal grid, velocity 127": pitch_track(fixed, rate, *band, stop=2.0)}
     glides = {name: note_glide(t, p) for name, (t, p) in tracks.items()}
     t_fixed, p_fixed = tracks["longitudinal grid, velocity 127"]
     late_fixed = glides["longitudinal grid, velocity 127"][1]
