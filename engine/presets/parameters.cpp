@@ -479,7 +479,7 @@ constexpr Parameter kTable[] = {
      .model = kString,
      .doc = "two-grid (to play): u on the finest grid (44) allows at tension_margin·T0, v on a "
             "coarse nested grid with h_v >= 1.05 sqrt(E/ρ)k — geometrically exact at audio rate "
-            "(pitch glide, phantom partials) at about half the cost of transverse. longitudinal "
+            "(pitch glide, phantom partials) at about 3/4 of the cost of transverse. longitudinal "
             "(the converged reference): h >= sqrt(E/ρ)k, as in the paper's runs; converged at "
             "oversampling 8–16, at a cost growing as its square. transverse (for comparison): u "
             "and v on u's grid; v cannot follow u at audio rate, so a loud note does not glide."},

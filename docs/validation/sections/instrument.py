@@ -324,7 +324,8 @@ def glide(ctx, f0, notes, rate):
                                      f"{vmax:g} m/s shifts the pitch by the same amount within 1 % "
                                      f"({sv['measured']:.4g} cents against the split scheme's "
                                      f"{lv['measured']:.4g})"))
-    out.append(f"\nOn the preset's transverse grid at {rate:.0f} Hz × {scheme['oversampling']} "
+    out.append(f"\nOn the transverse grid (the preset's rule before the two grids of the next "
+               f"section) at {rate:.0f} Hz × {scheme['oversampling']} "
                f"({trans_rows[0]['segments']} segments, k = 1/{1 / k_audio:.0f} s), same strikes:\n")
     out.append(table(trans_rows))
     out.append(
@@ -334,8 +335,8 @@ def glide(ctx, f0, notes, rate):
         f"the longitudinal grid shifts the pitch by {lv['measured']:.3g} cents, the transverse "
         f"grid by {tv['measured']:.2g}. "
         + (f"**On the transverse grid the shift is at most {100 * max(trans_ratios):.1g} % of "
-           "the estimate at every speed: the tension modulation is all but gone, and the tiny "
-           "glide of the shipped preset is an artefact of its grid rule, not physics.** "
+           "the estimate at every speed: the tension modulation is all but gone, an artefact of "
+           "that grid rule, not physics.** "
            if max(trans_ratios) < 0.5 else
            "The transverse grid follows the estimate too. ")
         + "Why: on that grid h is below √(E/ρ)k, so the longitudinal wave, which lives only in "
@@ -363,7 +364,9 @@ def glide(ctx, f0, notes, rate):
            f"{abs(gfix / g127):.0f} times less than the same preset on the longitudinal grid. "
            "The shipped fortissimo has no pitch glide because of its scheme setting (grid_rule "
            f"= \"transverse\"), not because the physics is weak at {vmax:g} m/s."
-           if abs(g127) < 0.1 * abs(gfix) else "comparable to the longitudinal grid's.")
+           if abs(g127) < 0.1 * abs(gfix) else
+           "comparable to the longitudinal grid's: the preset plays on the two grids, which "
+           "resolve the longitudinal wave at 48 kHz (next section).")
         + " (No measured piano pitch glides are in the shared data, so none is quoted here.)\n")
     out.append(code("\n".join(sweep_commands)))
     out.append("The other runs of the sweep differ only in `--hammer-velocity` (0.05 for the "
