@@ -63,6 +63,11 @@ WavWriter::WavWriter(std::string path, const std::string& flag, int sampleRate, 
   // step past the largest code — instead of wrapping it to -1. (It then rounds down, 1.2.0
   // measured: an error below one step, where without clipping it rounds to nearest.)
   if (format != SampleFormat::float32) sf_command(sound_, SFC_SET_CLIPPING, nullptr, SF_TRUE);
+  // A float file would get a PEAK chunk stamped with the time of writing, so two renders of the
+  // same input would differ in those bytes. The peaks are known to be within ±1 (sanitised), so
+  // the chunk says nothing worth a non-reproducible file. Must precede the first write.
+  if (format == SampleFormat::float32)
+    sf_command(sound_, SFC_SET_ADD_PEAK_CHUNK, nullptr, SF_FALSE);
   chunk_.resize(kChunkFrames * static_cast<std::size_t>(channels_));
 }
 

@@ -1,4 +1,5 @@
-// A WAV file written through libsndfile that appears whole on commit() or not at all.
+// A WAV file written through libsndfile that appears whole on commit() or not at all, and is the
+// same bytes for the same samples (no time stamp in any chunk).
 #pragma once
 
 #include <sndfile.h>

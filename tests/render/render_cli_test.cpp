@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "support/riff_chunks.h"
 #include "support/spectrum.h"
 
 namespace {
@@ -102,6 +103,27 @@ TEST_F(RenderCli, WritesTheRequestedRateChannelsFormatAndLength) {
     EXPECT_EQ(f.info.format & SF_FORMAT_SUBMASK,
               std::string(format) == "pcm24" ? SF_FORMAT_PCM_24 : SF_FORMAT_FLOAT);
     EXPECT_EQ(f.info.frames, 48000);
+  }
+}
+
+// The same command twice gives the same file, byte for byte, in every format: the chunks are
+// the format, (for float) the frame count, zero padding and the samples — nothing that records
+// when.
+TEST_F(RenderCli, TwoRendersAreTheSameBytesInEveryFormat) {
+  for (const char* format : {"pcm16", "pcm24", "float32"}) {
+    std::string bytes[2];
+    for (std::string& b : bytes) {
+      const Result r = run("--preset " + preset("paper-c3-string") +
+                           " --notes C3:100:0.1 --tail 0 --quiet --format " + format + " -o " +
+                           wav());
+      ASSERT_EQ(r.exitCode, 0) << r.err;
+      b = hamiltone::testing::fileBytes(wav());
+    }
+    EXPECT_EQ(bytes[0], bytes[1]) << format;
+    const std::vector<std::string> ids = hamiltone::testing::riffChunkIds(bytes[0]);
+    ASSERT_FALSE(ids.empty()) << format;
+    for (const std::string& id : ids)
+      EXPECT_TRUE(id == "fmt " || id == "fact" || id == "PAD " || id == "data") << format << ": chunk " << id;
   }
 }
 
