@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "atomic_file.h"
 #include "audio_output.h"
 #include "midi_input.h"
 #include "number_arguments.h"
@@ -85,6 +86,11 @@ int play(const PlayArguments& a) {
       a.device.empty() ? -1 : static_cast<int>(cli::parseInteger("--device", a.device, 0));
   const int voices =
       a.voices.empty() ? 0 : static_cast<int>(cli::parseInteger("--voices", a.voices, 1, 128));
+
+  std::vector<cli::InputFile> inputs;
+  for (const std::string& file : a.presets) inputs.push_back({"--preset", file});
+  if (a.presets.empty()) inputs.push_back({"--preset (the default)", HAMILTONE_DEFAULT_PRESET});
+  cli::refuseInputAsOutput("--record", a.record, inputs);
 
   // SIGINT and SIGTERM are taken by this thread alone (sigtimedwait below); every thread started
   // from here on — audio, MIDI, the recorder — inherits the mask.

@@ -12,8 +12,10 @@
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <mutex>
 #include <stdexcept>
+#include <system_error>
 #include <vector>
 
 #include "usage_error.h"
@@ -89,6 +91,29 @@ class SignalsHeld {
 
 }  // namespace
 
+bool sameFile(const std::string& a, const std::string& b) {
+  struct stat sa {
+  }, sb{};
+  if (::stat(a.c_str(), &sa) == 0 && ::stat(b.c_str(), &sb) == 0)
+    return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+  const auto resolved = [](const std::string& path) {
+    // Absolute first: weakly_canonical leaves a relative path with no existing part relative.
+    std::error_code error;
+    const std::filesystem::path absolute = std::filesystem::absolute(path, error);
+    std::filesystem::path p = std::filesystem::weakly_canonical(absolute, error);
+    return error ? absolute.lexically_normal() : p.lexically_normal();
+  };
+  return resolved(a) == resolved(b);
+}
+
+void refuseInputAsOutput(const std::string& flag, const std::string& path,
+                         const std::vector<InputFile>& inputs) {
+  for (const InputFile& input : inputs)
+    if (!path.empty() && !input.path.empty() && sameFile(path, input.path))
+      throw UsageError(flag + " = " + path + ": the same file as " + input.flag + " = " +
+                       input.path + ", which writing would destroy; expected another path");
+}
+
 AtomicFile::AtomicFile(std::string path, const std::string& flag) : path_(std::move(path)) {
   if (path_.empty()) throw UsageError(flag + " is empty: expected a file path");
   mode_t mode = 0;
@@ -106,6 +131,15 @@ AtomicFile::AtomicFile(std::string path, const std::string& flag) : path_(std::m
     }
     mode = existing.st_mode & 07777;
   } else {
+    struct stat link {};
+    if (::lstat(path_.c_str(), &link) == 0 && S_ISLNK(link.st_mode)) {
+      std::error_code error;
+      const std::string target = std::filesystem::read_symlink(path_, error).string();
+      throw UsageError(flag + " = " + path_ + ": a symbolic link to " +
+                       (error ? "an unreadable target" : target) +
+                       ", which does not exist; expected a new path, an existing file or a link "
+                       "to one");
+    }
     // mkstemp makes the file 0600; a new output gets the usual 0666 less the umask.
     const mode_t mask = ::umask(0);
     ::umask(mask);

@@ -4,13 +4,30 @@
 #include <cstdio>
 #include <initializer_list>
 #include <string>
+#include <vector>
 
 namespace hamiltone::cli {
+
+// Whether two paths name one file: the same device and inode when both exist (hard links,
+// symlinks, "./a" and "a" alike), else the same path once '.', '..' and the symlinks of its
+// existing part are resolved (what AtomicFile would rename onto).
+bool sameFile(const std::string& a, const std::string& b);
+
+// A file the program reads, by the flag that named it.
+struct InputFile {
+  std::string flag, path;
+};
+
+// Throws UsageError when the output `path` (given by `flag`) is one of the inputs, which writing
+// it would destroy; the message names both flags and paths.
+void refuseInputAsOutput(const std::string& flag, const std::string& path,
+                         const std::vector<InputFile>& inputs);
 
 class AtomicFile {
  public:
   // Creates the temporary now, so an unwritable path fails before any work is done. Throws
-  // UsageError naming `flag` and the path. SIGINT, SIGTERM, SIGHUP and SIGXFSZ remove every live
+  // UsageError naming `flag` and the path (also for a symlink to nothing: neither followed, as
+  // it would create a file elsewhere, nor replaced, as the link may be meant). SIGINT, SIGTERM, SIGHUP and SIGXFSZ remove every live
   // temporary (up to kMaxLive at once; one more is a std::runtime_error) and exit 128 + N.
   AtomicFile(std::string path, const std::string& flag);
   ~AtomicFile();  // removes the temporary unless published

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "atomic_file.h"
 #include "midi/midi_file.h"
 #include "note_list.h"
 #include "number_arguments.h"
@@ -45,6 +46,10 @@ int run(const RenderArguments& a) {
   if (a.midi.empty() == a.notes.empty())
     throw UsageError("give exactly one of --midi FILE or --notes LIST");
   if (a.out.empty()) throw UsageError("-o FILE: the WAV file to write is required");
+  std::vector<InputFile> inputs{{"--midi", a.midi}};
+  for (const std::string& file : a.presets) inputs.push_back({"--preset", file});
+  if (a.presets.empty()) inputs.push_back({"--preset (the default)", HAMILTONE_DEFAULT_PRESET});
+  refuseInputAsOutput("-o", a.out, inputs);
   const double rate =
       static_cast<double>(parseInteger("--sample-rate", a.sampleRate, 8000, 384000));
   const double tail = parseReal("--tail", a.tail, Range::nonNegative, " seconds");
@@ -156,7 +161,7 @@ int main(int argc, char** argv) {
                  "\"C3:100:2.0, E3@0.5:90:1.5\" (C4 = MIDI 60; START 0, VELOCITY 100 and "
                  "DURATION 1 s by default)")
       ->type_name("LIST");
-  app.add_option("-o,--out", a.out, "WAV file to write (replaced whole, or untouched on error)")
+  app.add_option("-o,--out", a.out, "WAV file to write (replaced whole, or untouched on error); not an input file")
       ->type_name("FILE");
   addNumberOption(&app, "--sample-rate", a.sampleRate, "HZ", "sample rate, 8000 … 384000");
   app.add_option("--format", a.format, "sample format")

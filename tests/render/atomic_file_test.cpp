@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "usage_error.h"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -118,6 +120,53 @@ TEST_F(AtomicFileTest, AFinishedFileIsOnlyPublishedOnRequest) {
   EXPECT_THROW(b.publish(), std::logic_error);
   b.commit();
   EXPECT_EQ(listing(), std::vector<std::string>{"b.csv"});
+}
+
+// A symlink to nothing is neither followed (that would create a file wherever it points) nor
+// replaced (the link may be what someone meant to keep): refused, naming the flag and the link.
+TEST_F(AtomicFileTest, ADanglingSymlinkIsRefusedAndKept) {
+  fs::create_symlink(dir_ / "missing.csv", dir_ / "link.csv");
+  try {
+    AtomicFile file(path("link.csv"), "--out");
+    FAIL() << "expected UsageError";
+  } catch (const hamiltone::cli::UsageError& e) {
+    EXPECT_NE(std::string(e.what()).find("--out = " + path("link.csv")), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("does not exist"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(fs::is_symlink(dir_ / "link.csv"));
+  EXPECT_EQ(listing(), std::vector<std::string>{"link.csv"});
+  // A link to an existing file is followed: the file is replaced, the link kept.
+  { std::ofstream(path("target.csv")) << "old\n"; }
+  fs::remove(dir_ / "link.csv");
+  fs::create_symlink(dir_ / "target.csv", dir_ / "link.csv");
+  AtomicFile file(path("link.csv"), "--out");
+  std::fputs("new\n", file.stream());
+  file.commit();
+  EXPECT_TRUE(fs::is_symlink(dir_ / "link.csv"));
+  EXPECT_EQ(slurp(path("target.csv")), "new\n");
+}
+
+// An output that is one of the inputs — by the same path, another spelling or a link — is refused
+// naming both flags; a different file, or an input not given (empty), is not.
+TEST_F(AtomicFileTest, AnInputAsOutputIsRefused) {
+  using hamiltone::cli::refuseInputAsOutput;
+  { std::ofstream(path("in.toml")) << "x\n"; }
+  fs::create_symlink(dir_ / "in.toml", dir_ / "link.wav");
+  const std::vector<hamiltone::cli::InputFile> inputs = {{"--midi", ""},
+                                                         {"--preset", path("in.toml")}};
+  for (const std::string& out :
+       {path("in.toml"), (dir_ / "." / "in.toml").string(), path("link.wav")}) {
+    try {
+      refuseInputAsOutput("-o", out, inputs);
+      ADD_FAILURE() << out << ": expected UsageError";
+    } catch (const hamiltone::cli::UsageError& e) {
+      EXPECT_NE(std::string(e.what()).find("-o = " + out), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("--preset = " + path("in.toml")), std::string::npos)
+          << e.what();
+    }
+  }
+  EXPECT_NO_THROW(refuseInputAsOutput("-o", path("out.wav"), inputs));
 }
 
 TEST_F(AtomicFileTest, TooManyAtOnceIsAnErrorThatLeavesNoTemporary) {

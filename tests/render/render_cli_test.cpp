@@ -178,6 +178,42 @@ TEST_F(RenderCli, RefusesBadInputAndWritesNothing) {
   EXPECT_NE(r.err.find("-o"), std::string::npos) << r.err;
 }
 
+// -o naming an input (the MIDI file, a preset — by its path or through a link) would destroy it,
+// and a symlink to nothing would create a file where the link points, or replace the link:
+// each is refused before any work, naming -o, and every file is left as it was.
+TEST_F(RenderCli, RefusesAnOutputThatIsAnInputOrADanglingSymlink) {
+  const fs::path midi = dir_ / "in.mid", toml = dir_ / "in.toml", link = dir_ / "link.wav";
+  fs::copy_file(HAMILTONE_SOURCE_DIR "/presets/demo.mid", midi);
+  fs::copy_file(preset("paper-c3-string"), toml);
+  const std::string midiBytes = hamiltone::testing::fileBytes(midi);
+  const std::string tomlBytes = hamiltone::testing::fileBytes(toml);
+  const auto expectRefusedOutput = [&](const std::string& args, const fs::path& out,
+                                       const std::string& mention) {
+    const Result r = run(args + " --quiet -o " + out.string());
+    EXPECT_EQ(r.exitCode, 2) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find("-o = " + out.string()), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(mention), std::string::npos) << r.err;
+    EXPECT_EQ(hamiltone::testing::fileBytes(midi), midiBytes) << args;
+    EXPECT_EQ(hamiltone::testing::fileBytes(toml), tomlBytes) << args;
+  };
+  expectRefusedOutput("--preset " + toml.string() + " --midi " + midi.string(), midi, "--midi");
+  expectRefusedOutput("--preset " + toml.string() + " --notes C3", toml, "--preset");
+  fs::create_symlink(toml, link);
+  expectRefusedOutput("--preset " + toml.string() + " --notes C3", link, "--preset");
+  fs::remove(link);
+  fs::create_symlink(dir_ / "nowhere" / "x.wav", link);
+  expectRefusedOutput("--preset " + toml.string() + " --notes C3", link, "does not exist");
+  EXPECT_TRUE(fs::is_symlink(link));
+  fs::remove(link);
+  fs::create_symlink(dir_ / "missing.wav", link);
+  expectRefusedOutput("--preset " + toml.string() + " --notes C3", link, "does not exist");
+  EXPECT_TRUE(fs::is_symlink(link));
+  EXPECT_FALSE(fs::exists(dir_ / "missing.wav"));
+  std::size_t files = 0;
+  for ([[maybe_unused]] const auto& entry : fs::directory_iterator(dir_)) ++files;
+  EXPECT_EQ(files, 3u);  // the inputs and the link: no temporary
+}
+
 TEST_F(RenderCli, ListsTheParameterTable) {
   const std::string out = (dir_ / "params.txt").string();
   const int status =
