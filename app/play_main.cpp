@@ -146,15 +146,26 @@ int play(const PlayArguments& a) {
                  a.api.c_str(), rate, buffer, 1000.0 * buffer / rate);
   timespec wait{0, 250'000'000};
   int signal = -1;
+  bool recordingFailureShown = false;
   while (signal < 0) {
     signal = sigtimedwait(&stopSignals, nullptr, &wait);
+    // A failed recording is said at once, on a line of its own; the sound plays on.
+    if (recorder && recorder->failed() && !recordingFailureShown) {
+      recordingFailureShown = true;
+      std::fprintf(stderr,
+                   "%shamiltone-play: recording stopped at %.2f s: %s; still playing (the %.2f s "
+                   "written are kept at exit)\n",
+                   status ? "\n" : "", recorder->failedAtSeconds(), recorder->error().c_str(),
+                   recorder->failedAtSeconds());
+    }
     if (!status) continue;
     const Player::Status s = player.status();
     std::fprintf(stderr,
                  "\r  voices %2d/%-3d  cpu %3.0f%% (peak %3.0f%%)  underruns %ld (late %ld)  "
-                 "midi %-12s  guard %d   ",
+                 "midi %-12s  guard %d%s   ",
                  s.voices, s.limit, 100.0 * s.load, 100.0 * s.peakLoad, audio.underruns(), s.late,
-                 describe(s.lastMessage).c_str(), s.guardEvents);
+                 describe(s.lastMessage).c_str(), s.guardEvents,
+                 recordingFailureShown ? "  REC STOPPED" : "");
     std::fflush(stderr);
   }
   audio.stop();
@@ -168,9 +179,21 @@ int play(const PlayArguments& a) {
                100.0 * s.peakLoad, s.guardEvents);
   if (recorder) {
     const double seconds = recorder->finish();
-    std::fprintf(stderr, "hamiltone-play: recorded %.2f s to %s%s%s\n", seconds, a.record.c_str(),
-                 s.recordDropped ? " (with gaps: the disk fell behind)" : "",
-                 recorder->truncatedFrames() ? " (cut at the 4 GiB a WAV file holds)" : "");
+    if (!recorder->failed()) {
+      std::fprintf(stderr, "hamiltone-play: recorded %.2f s to %s%s%s\n", seconds,
+                   a.record.c_str(), s.recordDropped ? " (with gaps: the disk fell behind)" : "",
+                   recorder->truncatedFrames() ? " (cut at the 4 GiB a WAV file holds)" : "");
+    } else if (recorder->kept()) {
+      std::fprintf(stderr,
+                   "hamiltone-play: error: the recording stopped at %.2f s (%s); %s holds the "
+                   "%.2f s written before\n",
+                   recorder->failedAtSeconds(), recorder->error().c_str(), a.record.c_str(),
+                   seconds);
+    } else {
+      std::fprintf(stderr, "hamiltone-play: error: the recording failed (%s); no file written\n",
+                   recorder->error().c_str());
+    }
+    if (recorder->failed()) return 1;
   }
   return 0;
 }
@@ -204,7 +227,8 @@ int main(int argc, char** argv) {
   app.add_flag("--list-devices", a.listDevices, "list the APIs, output devices and MIDI ports");
   app.add_flag("--quiet", a.quiet, "no status line");
   app.footer(
-      "Exit codes: 0 stopped by SIGINT/SIGTERM (the recording is complete), 1 an I/O error, "
+      "Exit codes: 0 stopped by SIGINT/SIGTERM (the recording is complete), 1 an I/O error (a "
+      "recording that failed, e.g. on a full disk, keeps what was written before the error), "
       "2 bad input or no usable audio API/device.");
   try {
     app.parse(argc, argv);

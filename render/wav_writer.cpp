@@ -3,6 +3,8 @@
 // commit() renames it, the destructor and SIGINT/SIGTERM/SIGHUP remove it.
 #include "wav_writer.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -81,9 +83,13 @@ void WavWriter::write(const float* interleaved, std::size_t frames) {
     const std::size_t n = std::min(frames, kChunkFrames);
     const std::size_t samples = n * static_cast<std::size_t>(channels_);
     std::transform(interleaved, interleaved + samples, chunk_.begin(), sanitised);
-    if (sf_writef_float(sound_, chunk_.data(), static_cast<sf_count_t>(n)) !=
-        static_cast<sf_count_t>(n))
+    const sf_count_t done = sf_writef_float(sound_, chunk_.data(), static_cast<sf_count_t>(n));
+    if (done != static_cast<sf_count_t>(n)) {
+      written_ += static_cast<std::size_t>(std::max<sf_count_t>(done, 0));
+      failed_ = true;
       throw std::runtime_error("writing " + path_ + " failed: " + sf_strerror(sound_));
+    }
+    written_ += n;
     interleaved += samples;
     frames -= n;
   }
@@ -91,6 +97,18 @@ void WavWriter::write(const float* interleaved, std::size_t frames) {
 
 void WavWriter::commit() {
   if (!sound_) throw std::logic_error("WavWriter::commit twice: " + path_);
+  if (failed_) {
+    // Cut what a failed write left past the last whole frame: seeking the write position to
+    // that frame puts the descriptor at the end of the data that is kept. libsndfile computes
+    // the header's sizes from the file's length on close.
+    const int fd = fileno(file_.stream());
+    const off_t end = sf_seek(sound_, static_cast<sf_count_t>(written_), SEEK_SET) < 0
+                          ? -1
+                          : ::lseek(fd, 0, SEEK_CUR);
+    if (end < 0 || ::ftruncate(fd, end) != 0)
+      throw std::runtime_error("writing " + path_ + " failed: cannot cut it to the " +
+                               std::to_string(written_) + " frames written");
+  }
   const int error = sf_close(sound_);  // writes the final header
   sound_ = nullptr;
   if (error != SF_ERR_NO_ERROR)

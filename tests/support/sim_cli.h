@@ -3,7 +3,6 @@
 #pragma once
 
 #include <gtest/gtest.h>
-#include <sys/mount.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -16,31 +15,13 @@
 #include <string>
 #include <vector>
 
+#include "support/tiny_disk.h"
+
 namespace hamiltone::test {
 
 struct CliResult {
   int exitCode;
   std::string out, err;
-};
-
-// A full disk to write to: a 64 KiB tmpfs mounted on `dir` while alive. Needs root (or
-// CAP_SYS_ADMIN); mounted() is false where that fails, and the test should skip.
-class TinyDisk {
- public:
-  explicit TinyDisk(const std::filesystem::path& dir) : dir_(dir) {
-    std::filesystem::create_directories(dir_);
-    mounted_ = ::geteuid() == 0 && ::mount("tmpfs", dir_.c_str(), "tmpfs", 0, "size=64k") == 0;
-  }
-  ~TinyDisk() {
-    if (mounted_) ::umount2(dir_.c_str(), MNT_DETACH);
-  }
-  TinyDisk(const TinyDisk&) = delete;
-  TinyDisk& operator=(const TinyDisk&) = delete;
-  bool mounted() const { return mounted_; }
-
- private:
-  std::filesystem::path dir_;
-  bool mounted_ = false;
 };
 
 class SimCliTest : public ::testing::Test {
