@@ -60,6 +60,11 @@ std::string describe(std::uint32_t m) {
   return text;
 }
 
+std::string signalName(int signal) {
+  const char* abbreviation = ::sigabbrev_np(signal);
+  return abbreviation ? std::string("SIG") + abbreviation : "signal " + std::to_string(signal);
+}
+
 int listDevices(const std::string& api) {
   std::printf("audio APIs in this build:");
   for (const std::string& a : AudioOutput::compiledApis()) std::printf(" %s", a.c_str());
@@ -92,12 +97,17 @@ int play(const PlayArguments& a) {
   if (a.presets.empty()) inputs.push_back({"--preset (the default)", HAMILTONE_DEFAULT_PRESET});
   cli::refuseInputAsOutput("--record", a.record, inputs);
 
-  // SIGINT and SIGTERM are taken by this thread alone (sigtimedwait below); every thread started
-  // from here on — audio, MIDI, the recorder — inherits the mask.
+  // Every signal that would end the program stops it instead, completing the recording: they are
+  // taken by this thread alone (sigtimedwait below), and every thread started from here on —
+  // audio, MIDI, the recorder — inherits the mask. A signal inherited as ignored (nohup's
+  // SIGHUP) is left out: blocked, Linux would queue it for sigtimedwait rather than drop it.
   sigset_t stopSignals;
   sigemptyset(&stopSignals);
-  sigaddset(&stopSignals, SIGINT);
-  sigaddset(&stopSignals, SIGTERM);
+  for (const int s : cli::AtomicFile::kEndingSignals) {
+    struct sigaction current {};
+    if (::sigaction(s, nullptr, &current) == 0 && current.sa_handler != SIG_IGN)
+      sigaddset(&stopSignals, s);
+  }
   pthread_sigmask(SIG_BLOCK, &stopSignals, nullptr);
 
   // Presets load and their voices are built here, off the audio thread; program change then only
@@ -175,7 +185,7 @@ int play(const PlayArguments& a) {
   std::fprintf(stderr,
                "hamiltone-play: stopped by %s; underruns %ld; late callbacks %ld; peak cpu %.0f%%; "
                "guard events %d\n",
-               signal == SIGINT ? "SIGINT" : "SIGTERM", audio.underruns(), s.late,
+               signalName(signal).c_str(), audio.underruns(), s.late,
                100.0 * s.peakLoad, s.guardEvents);
   if (recorder) {
     const double seconds = recorder->finish();
@@ -195,7 +205,8 @@ int play(const PlayArguments& a) {
     }
     if (recorder->failed()) return 1;
   }
-  return 0;
+  // The signals meant to stop a program end it normally; another is reported as a shell would.
+  return signal == SIGINT || signal == SIGTERM || signal == SIGHUP ? 0 : 128 + signal;
 }
 
 }  // namespace
@@ -227,7 +238,10 @@ int main(int argc, char** argv) {
   app.add_flag("--list-devices", a.listDevices, "list the APIs, output devices and MIDI ports");
   app.add_flag("--quiet", a.quiet, "no status line");
   app.footer(
-      "Exit codes: 0 stopped by SIGINT/SIGTERM (the recording is complete), 1 an I/O error (a "
+      "Signals: SIGINT, SIGTERM and SIGHUP stop it normally; SIGUSR1, SIGPIPE, SIGALRM and the "
+      "other signals that would end it stop it too, completing the recording, and exit 128+N; "
+      "a signal ignored when it starts (nohup) stays ignored. "
+      "Exit codes: 0 stopped by SIGINT/SIGTERM/SIGHUP (the recording is complete), 1 an I/O error (a "
       "recording that failed, e.g. on a full disk, keeps what was written before the error), "
       "2 bad input or no usable audio API/device.");
   try {

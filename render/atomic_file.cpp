@@ -22,6 +22,10 @@
 
 namespace hamiltone::cli {
 
+// SIGXFSZ: past the file-size limit (ulimit -f). Not SIGQUIT, whose core dump is wanted as is.
+const int AtomicFile::kEndingSignals[12] = {SIGHUP,  SIGINT,    SIGTERM, SIGUSR1, SIGUSR2, SIGPIPE,
+                                            SIGALRM, SIGVTALRM, SIGPROF, SIGXCPU, SIGXFSZ, SIGPOLL};
+
 namespace {
 
 // The temporaries being written, for the signal handler: fixed buffers, as only
@@ -36,8 +40,7 @@ struct Slot {
 static_assert(std::atomic<int>::is_always_lock_free);
 Slot liveTemporaries[AtomicFile::kMaxLive];
 
-constexpr int kHandledSignals[] = {SIGINT, SIGTERM, SIGHUP,
-                                   SIGXFSZ};  // SIGXFSZ: past the file-size limit (ulimit -f)
+const auto& kHandledSignals = AtomicFile::kEndingSignals;
 
 extern "C" void removeTemporariesAndExit(int signal) {
   for (Slot& slot : liveTemporaries)
@@ -45,11 +48,52 @@ extern "C" void removeTemporariesAndExit(int signal) {
   ::_exit(128 + signal);
 }
 
+// Each signal's handler, unless it is ignored: an ignore set by whoever started the program
+// (nohup, a shell's trap '') is a request to keep running.
 void installHandler() {
   static std::once_flag once;
   std::call_once(once, [] {
-    for (const int s : kHandledSignals) std::signal(s, removeTemporariesAndExit);
+    struct sigaction action {};
+    action.sa_handler = removeTemporariesAndExit;
+    sigemptyset(&action.sa_mask);
+    for (const int s : kHandledSignals) sigaddset(&action.sa_mask, s);  // one handler at a time
+    for (const int s : kHandledSignals) {
+      struct sigaction current {};
+      if (::sigaction(s, nullptr, &current) == 0 && current.sa_handler == SIG_IGN) continue;
+      ::sigaction(s, &action, nullptr);
+    }
   });
+}
+
+// The PID in a temporary's name "NAME.tmp-PID-XXXXXX" after `prefix` ("NAME.tmp-"), or 0.
+pid_t temporaryOwner(const std::string& name, const std::string& prefix) {
+  if (name.size() <= prefix.size() + 7 || name.compare(0, prefix.size(), prefix) != 0) return 0;
+  const std::string rest = name.substr(prefix.size());
+  const std::size_t dash = rest.find('-');
+  if (dash == 0 || dash == std::string::npos || rest.size() != dash + 7) return 0;
+  pid_t pid = 0;
+  for (std::size_t i = 0; i < dash; ++i) {
+    if (rest[i] < '0' || rest[i] > '9' || pid > 1'000'000'000) return 0;
+    pid = pid * 10 + (rest[i] - '0');
+  }
+  return pid;
+}
+
+// Removes the temporaries of `path` whose process is gone: left by a run killed by SIGKILL, or
+// one that crashed. A process in another PID namespace or on another host that shares the
+// directory is not seen; its temporary would be taken for stale — not a case this tool meets.
+void removeStaleTemporaries(const std::string& path) {
+  const std::filesystem::path target(path);
+  const std::string prefix = target.filename().string() + ".tmp-";
+  std::error_code error;
+  const std::filesystem::path dir =
+      target.has_parent_path() ? target.parent_path() : std::filesystem::path(".");
+  for (std::filesystem::directory_iterator it(dir, error), end; !error && it != end;
+       it.increment(error)) {
+    const pid_t owner = temporaryOwner(it->path().filename().string(), prefix);
+    if (owner > 0 && owner != ::getpid() && ::kill(owner, 0) != 0 && errno == ESRCH)
+      ::unlink(it->path().c_str());
+  }
 }
 
 // The slot now holding `path`, or -1 when it cannot be held (then the caller gives up).
@@ -145,7 +189,8 @@ AtomicFile::AtomicFile(std::string path, const std::string& flag) : path_(std::m
     ::umask(mask);
     mode = 0666 & ~mask;
   }
-  std::string pattern = path_ + ".tmp-XXXXXX";
+  removeStaleTemporaries(path_);
+  std::string pattern = path_ + ".tmp-" + std::to_string(::getpid()) + "-XXXXXX";
   std::vector<char> name(pattern.begin(), pattern.end());
   name.push_back('\0');
   // The signal handler must know the temporary from the moment it exists: hold the signals

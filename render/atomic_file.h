@@ -27,14 +27,20 @@ class AtomicFile {
  public:
   // Creates the temporary now, so an unwritable path fails before any work is done. Throws
   // UsageError naming `flag` and the path (also for a symlink to nothing: neither followed, as
-  // it would create a file elsewhere, nor replaced, as the link may be meant). SIGINT, SIGTERM, SIGHUP and SIGXFSZ remove every live
-  // temporary (up to kMaxLive at once; one more is a std::runtime_error) and exit 128 + N.
+  // it would create a file elsewhere, nor replaced, as the link may be meant).
+  //
+  // Every signal whose default would end the program (kEndingSignals) removes every live
+  // temporary (up to kMaxLive at once; one more is a std::runtime_error) and exits 128 + N —
+  // except a signal the program inherited as ignored (nohup's SIGHUP), which stays ignored.
+  // The temporary is named PATH.tmp-PID-XXXXXX: one left by a run that could not clean up
+  // (SIGKILL, a crash) is removed when a later run writes PATH and that PID is gone.
   AtomicFile(std::string path, const std::string& flag);
   ~AtomicFile();  // removes the temporary unless published
   AtomicFile(const AtomicFile&) = delete;
   AtomicFile& operator=(const AtomicFile&) = delete;
 
   static constexpr int kMaxLive = 16;
+  static const int kEndingSignals[12];
 
   std::FILE* stream() { return file_; }
   // Flushes and closes the temporary, keeping it; throws std::runtime_error on an I/O error (a

@@ -175,7 +175,8 @@ int main(int argc, char** argv) {
                "print every preset parameter (name, type, unit, range, default) and exit");
   app.footer(
       "Exit codes: 0 done, 1 an I/O error (no file is left), 2 bad input (arguments, preset or "
-      "MIDI file; no file is written), 128+N killed by signal N (no file left).");
+      "MIDI file; no file is written), 128+N ended by signal N (no file left; a signal ignored "
+      "when it starts, as under nohup, stays ignored).");
 
   try {
     app.parse(argc, argv);

@@ -1,6 +1,6 @@
 // libsndfile writes through the descriptor of an AtomicFile's temporary (sf_open_fd, which
 // leaves the descriptor to AtomicFile), so AtomicFile alone decides whether the file appears:
-// commit() renames it, the destructor and SIGINT/SIGTERM/SIGHUP remove it.
+// commit() renames it, the destructor and the signals that end the program remove it.
 #include "wav_writer.h"
 
 #include <unistd.h>

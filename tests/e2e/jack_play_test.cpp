@@ -295,30 +295,29 @@ class JackPlay : public ::testing::Test {
 
   fs::path wav() const { return dir_ / "out.wav"; }
 
-  // A server of its own, the player on it, the score from the sender, at least 10 s of audio;
-  // then SIGINT to the player and SIGTERM to the server. Fatal failures for anything that keeps
-  // the run from happening.
-  void perform(bool realtime, int attempt, Performance& run) {
-    stopAll();
-    useServer(name_ + "-" + std::to_string(attempt));
+  // A server of its own (server_) on the dummy driver, answering. Fatal failure otherwise.
+  void startServer(bool realtime) {
     spawn(jackd_,
           {"jackd", "-n", server_, realtime ? "--realtime" : "--no-realtime", "-d", "dummy", "-r",
            "48000", "-p", std::to_string(kPeriod)},
           "jackd");
     ASSERT_TRUE(jackd_->started());
-    Clock::time_point deadline = Clock::now() + 15s;
+    const Clock::time_point deadline = Clock::now() + 15s;
     while (!ports() && Clock::now() < deadline && !jackd_->wait(0.1)) {
     }
     ASSERT_TRUE(ports()) << "the JACK server did not come up:\n" << slurp(dir_ / "jackd.err");
+  }
 
-    spawn(player_,
-          {HAMILTONE_PLAY, "--api", "jack", "--virtual-midi", "hamiltone-in", "--record",
-           wav().string(), "--quiet", "--preset", HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml",
-           "--preset", HAMILTONE_SOURCE_DIR "/presets/paper-c3-string.toml"},
-          "player");
+  // The player on that server, recording to `record`, with `extra` arguments; returns when it is
+  // ready — its MIDI port exists, and the stream starts right after it is made.
+  void startPlayer(const std::vector<std::string>& extra, const fs::path& record = {}) {
+    std::vector<std::string> argv = {HAMILTONE_PLAY, "--api",    "jack",
+                                     "--virtual-midi", "hamiltone-in", "--record",
+                                     (record.empty() ? wav() : record).string(), "--quiet"};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    spawn(player_, argv, "player");
     ASSERT_TRUE(player_->started());
-    // Ready when its MIDI port exists: the stream starts right after it is made.
-    deadline = Clock::now() + 60s;
+    const Clock::time_point deadline = Clock::now() + 60s;
     std::string list;
     while (list.find(":hamiltone-in") == std::string::npos && Clock::now() < deadline &&
            !player_->wait(0.1))
@@ -326,6 +325,18 @@ class JackPlay : public ::testing::Test {
     ASSERT_NE(list.find(":hamiltone-in"), std::string::npos)
         << "the player's MIDI port did not appear:\n"
         << slurp(dir_ / "player.err");
+  }
+
+  // A server of its own, the player on it, the score from the sender, at least 10 s of audio;
+  // then SIGINT to the player and SIGTERM to the server. Fatal failures for anything that keeps
+  // the run from happening.
+  void perform(bool realtime, int attempt, Performance& run) {
+    stopAll();
+    useServer(name_ + "-" + std::to_string(attempt));
+    ASSERT_NO_FATAL_FAILURE(startServer(realtime));
+    ASSERT_NO_FATAL_FAILURE(
+        startPlayer({"--preset", HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml", "--preset",
+                     HAMILTONE_SOURCE_DIR "/presets/paper-c3-string.toml"}));
     const Clock::time_point readyAt = Clock::now();
 
     spawn(sender_, {HAMILTONE_MIDI_SENDER, "hamiltone-in", "10"}, "sender");
@@ -459,6 +470,40 @@ TEST_F(JackPlay, PlaysAScriptedPerformanceOnTimeInTuneAndWithoutUnderruns) {
   ASSERT_LT(overran, kAttempts) << "the player's callback took longer than its period in every run";
   GTEST_SKIP() << "the JACK server logged xruns in all " << kAttempts
                << " runs (a busy host): onset timing and underruns were not judged";
+}
+
+// The files in the test's directory whose name marks a temporary.
+std::vector<std::string> temporaries(const fs::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dir))
+    if (entry.path().filename().string().find(".tmp-") != std::string::npos)
+      names.push_back(entry.path().filename());
+  return names;
+}
+
+// Under nohup (SIGHUP inherited as ignored) a hang-up leaves the player playing; a signal that
+// would end it — here SIGUSR1 — stops it with the recording complete, exit 128 + N, no temporary.
+TEST_F(JackPlay, KeepsAnIgnoredHangupAndCompletesTheRecordingOnOtherSignals) {
+  if (!onPath("jackd") || !onPath("jack_lsp"))
+    GTEST_SKIP() << "jackd (Debian's jackd2) is not installed";
+  ASSERT_NO_FATAL_FAILURE(startServer(false));
+  struct sigaction ignore {}, previous{};
+  ignore.sa_handler = SIG_IGN;
+  ::sigaction(SIGHUP, &ignore, &previous);  // inherited by the player, as under nohup
+  startPlayer({"--preset", HAMILTONE_SOURCE_DIR "/presets/paper-c3-string.toml"});
+  ::sigaction(SIGHUP, &previous, nullptr);
+  ASSERT_FALSE(HasFatalFailure());
+  player_->signal(SIGHUP);
+  EXPECT_FALSE(player_->wait(1.0)) << "a hang-up ended the player:\n"
+                                   << slurp(dir_ / "player.err");
+  player_->signal(SIGUSR1);
+  EXPECT_EQ(player_->wait(30.0), 128 + SIGUSR1);
+  const std::string err = slurp(dir_ / "player.err");
+  EXPECT_NE(err.find("stopped by SIGUSR1"), std::string::npos) << err;
+  EXPECT_NE(err.find("recorded "), std::string::npos) << err;
+  SF_INFO info;
+  EXPECT_GT(readMono(wav(), info).size(), 24000u) << "the second it played, less start-up";
+  EXPECT_TRUE(temporaries(dir_).empty());
 }
 
 TEST_F(JackPlay, WithoutAServerRefusesInOneLineWithExitCode2) {

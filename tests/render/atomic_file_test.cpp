@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <csignal>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -79,6 +81,62 @@ TEST_F(AtomicFileTest, SignalRemovesEveryLiveTemporary) {
   EXPECT_TRUE(listing().empty());
   EXPECT_EXIT(reusedSlotThenSignal(dir_, SIGINT), ::testing::ExitedWithCode(128 + SIGINT), "");
   EXPECT_TRUE(listing().empty());
+}
+
+// Every signal that would end the program by default removes the temporaries, not only the
+// usual three: a stray SIGUSR1, a SIGPIPE from a closed pipe, a timeout's SIGALRM.
+TEST_F(AtomicFileTest, EverySignalThatWouldEndTheProgramRemovesTheTemporaries) {
+  for (const int signal : AtomicFile::kEndingSignals) {
+    EXPECT_EXIT(threeOpenThenSignal(dir_, signal), ::testing::ExitedWithCode(128 + signal), "")
+        << ::strsignal(signal);
+    EXPECT_TRUE(listing().empty()) << ::strsignal(signal);
+  }
+}
+
+// A signal ignored by whoever started the program (nohup, trap '' HUP) stays ignored: the run
+// goes on and its file appears. A signal not ignored still removes the temporaries.
+void ignoredHangupThenCommit(const fs::path& dir) {
+  std::signal(SIGHUP, SIG_IGN);
+  AtomicFile a((dir / "a.csv").string(), "--out");
+  std::fputs("data\n", a.stream());
+  std::raise(SIGHUP);
+  a.commit();
+  std::raise(SIGUSR1);  // handled: ends the child, which removes nothing now (all published)
+}
+
+TEST_F(AtomicFileTest, AnInheritedIgnoreIsKept) {
+  EXPECT_EXIT(ignoredHangupThenCommit(dir_), ::testing::ExitedWithCode(128 + SIGUSR1), "");
+  EXPECT_EQ(slurp(path("a.csv")), "data\n");
+  EXPECT_EQ(listing(), std::vector<std::string>{"a.csv"});
+}
+
+// A run killed by SIGKILL cannot clean up: its temporary, named after its PID, is removed by the
+// next run that writes the same file once that PID is gone — and only then: a temporary of a
+// live process (here this test's own PID), or another file, is left alone.
+void openThenKill(const fs::path& dir) {
+  AtomicFile a((dir / "a.wav").string(), "-o");
+  std::fputs("half a take", a.stream());
+  std::fflush(a.stream());
+  std::raise(SIGKILL);
+}
+
+TEST_F(AtomicFileTest, ATemporaryLeftBySigkillIsRemovedByTheNextRun) {
+  EXPECT_EXIT(openThenKill(dir_), ::testing::KilledBySignal(SIGKILL), "");
+  ASSERT_EQ(listing().size(), 1u);
+  const std::string stale = listing().front();
+  EXPECT_TRUE(stale.starts_with("a.wav.tmp-")) << stale;
+  const std::string live = "a.wav.tmp-" + std::to_string(::getpid()) + "-abcdef";
+  { std::ofstream(path(live)) << "a live run's"; }
+  { std::ofstream(path("a.wav.tmp-notes.txt")) << "someone's"; }
+  AtomicFile again(path("a.wav"), "-o");
+  std::fputs("whole", again.stream());
+  again.commit();
+  std::vector<std::string> names = listing();
+  std::sort(names.begin(), names.end());
+  std::vector<std::string> kept = {"a.wav", "a.wav.tmp-notes.txt", live};
+  std::sort(kept.begin(), kept.end());
+  EXPECT_EQ(names, kept);
+  EXPECT_EQ(slurp(path("a.wav")), "whole");
 }
 
 TEST_F(AtomicFileTest, CommitTogetherPublishesEveryFile) {
