@@ -129,16 +129,14 @@ int run(const RenderArguments& a) {
   const RenderStats stats = renderPerformance(synth, messages, seconds, block, rate, out,
                                               [&](double done) { bar.update(done); });
   bar.finish();
+  // An output the program knows is wrong is not written: the temporary goes with `out`.
+  if (stats.guardEvents > 0 || stats.nonFinite > 0)
+    throw UsageError(instabilityReport(synth, stats));
   out.commit();
   if (!a.quiet) {
     std::fprintf(stderr, "hamiltone-render: %s: %s\n", a.out.c_str(),
                  renderSummary(stats.seconds, stats.wallSeconds).c_str());
   }
-  if (stats.guardEvents > 0 || stats.nonFinite > 0)
-    std::fprintf(stderr,
-                 "hamiltone-render: warning: the guard silenced %d voice(s) and %ld non-finite "
-                 "sample(s) were zeroed: the preset is unstable for these notes\n",
-                 stats.guardEvents, stats.nonFinite);
   return 0;
 }
 
@@ -175,7 +173,7 @@ int main(int argc, char** argv) {
                "print every preset parameter (name, type, unit, range, default) and exit");
   app.footer(
       "Exit codes: 0 done, 1 an I/O error (no file is left), 2 bad input (arguments, preset or "
-      "MIDI file; no file is written), 128+N ended by signal N (no file left; a signal ignored "
+      "MIDI file, or a preset found unstable for the notes played; no file is written), 128+N ended by signal N (no file left; a signal ignored "
       "when it starts, as under nohup, stays ignored).");
 
   try {

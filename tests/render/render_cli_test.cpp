@@ -214,6 +214,25 @@ TEST_F(RenderCli, RefusesAnOutputThatIsAnInputOrADanglingSymlink) {
   EXPECT_EQ(files, 3u);  // the inputs and the link: no temporary
 }
 
+// A preset the guard has to silence renders noise, or silence, where notes were asked for: the
+// output is known to be wrong, so none is written, the exit code is 2 (bad input) and the message
+// names the preset and the parameter at fault. Here the gauge shift ε = 10⁶ J, far above the
+// energies of a struck string (~10⁻² J), which with any check on ε at load gives the same result.
+TEST_F(RenderCli, AnUnstablePresetIsAnErrorAndWritesNothing) {
+  std::string text = hamiltone::testing::fileBytes(preset("paper-c3-string"));
+  const std::string was = "epsilon_J = 0.0 ";
+  ASSERT_NE(text.find(was), std::string::npos);
+  text.replace(text.find(was), was.size(), "epsilon_J = 1e6 ");
+  const fs::path unstable = dir_ / "unstable.toml";
+  std::ofstream(unstable) << text;
+  const Result r = run("--preset " + unstable.string() + " --notes C3:127:0.5 --tail 0 -o " + wav());
+  EXPECT_EQ(r.exitCode, 2) << r.err;
+  EXPECT_NE(r.err.find("unstable.toml"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("epsilon_J"), std::string::npos) << r.err;
+  for (const auto& entry : fs::directory_iterator(dir_))  // the preset, no WAV, no temporary
+    EXPECT_EQ(entry.path().filename().string().find("out.wav"), std::string::npos);
+}
+
 TEST_F(RenderCli, ListsTheParameterTable) {
   const std::string out = (dir_ / "params.txt").string();
   const int status =
