@@ -5,11 +5,19 @@
 
 namespace hamiltone::cli {
 
-long stepCount(double duration, double k, const std::string& ratio) {
+long stepCount(double duration, double k, const std::string& durationFlag,
+               const std::string& stepFlag) {
   const double steps = std::floor(duration / k * (1.0 + 1e-12));
-  if (!(steps >= 1.0) || steps > kMaxSteps)
-    throw UsageError(ratio + " = " + std::to_string(duration / k) +
-                     " steps: expected between 1 and 1e10");
+  if (!(steps >= 1.0))
+    throw UsageError(stepFlag + " = " + formatNumber(k) + " s: longer than " + durationFlag +
+                     " = " + formatNumber(duration) + " s; expected a step at most " +
+                     durationFlag);
+  if (steps > kMaxSteps)
+    throw UsageError(durationFlag + " / " + stepFlag + " = " + formatApprox(duration / k) +
+                     " steps (" + durationFlag + " = " + formatNumber(duration) + " s, " +
+                     stepFlag + " = " + formatNumber(k) +
+                     " s): expected at most 1e10; shorten " + durationFlag + " or raise " +
+                     stepFlag);
   return static_cast<long>(steps);
 }
 

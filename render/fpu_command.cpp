@@ -160,7 +160,7 @@ int runSlowFast(const FpuArguments& a) {
   if (hf >= bound)
     throw UsageError("--hf = " + a.hf + ": the CFL bound (16) of the linear springs is h_F < " +
                      formatNumber(bound) + " s");
-  const long coarseSteps = stepCount(duration, hs, "--duration / --hs");
+  const long coarseSteps = stepCount(duration, hs, "--duration", "--hs");
   // Both schemes take K steps of h_F per coarse step: count them (and the particle steps) in
   // double, where they cannot overflow, before any is taken.
   const double fineSteps = static_cast<double>(coarseSteps) * ratio;

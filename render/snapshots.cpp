@@ -7,6 +7,7 @@
 #include "atomic_file.h"
 #include "number_arguments.h"
 #include "usage_error.h"
+#include "util/format_number.h"
 
 namespace hamiltone::cli {
 
@@ -35,7 +36,7 @@ std::vector<long> snapshotSteps(const std::string& times, double k, long steps) 
     const long n = static_cast<long>(std::ceil(t / k * (1.0 - 1e-12)));
     if (n > steps)
       throw UsageError("--snapshots = " + item + ": after the last step (t = " +
-                       std::to_string(static_cast<double>(steps) * k) +
+                       formatApprox(static_cast<double>(steps) * k) +
                        " s); expected times <= --duration");
     result.push_back(n);
     if (comma == std::string::npos) break;

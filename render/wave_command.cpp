@@ -19,6 +19,7 @@
 #include "schemes/variable_step_marazzato.h"
 #include "snapshots.h"
 #include "usage_error.h"
+#include "util/format_number.h"
 
 namespace hamiltone::cli {
 
@@ -206,7 +207,7 @@ int runWaveCommand(const WaveArguments& a) {
   });
   const double start = scheme.pseudoEnergy();
   if (!std::isfinite(start))
-    throw UsageError("the start's pseudo-energy is " + std::to_string(start) +
+    throw UsageError("the start's pseudo-energy is " + formatApprox(start) +
                      ": --amplitude is too large for double precision");
   // H̃⁰ = V(q⁰) >= 0. At 0 or below the normal doubles (a tiny --amplitude) there is no energy
   // to measure drift against; the adaptive bound gap <= eps_fly H̃ cannot hold there at all.
