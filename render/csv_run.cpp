@@ -29,6 +29,33 @@ void checkOutputSize(long steps, long every, long columns, const std::string& re
                      " GB): expected at most 2e8; " + remedy);
 }
 
+namespace {
+
+// A time in the unit that reads best: "40 s", "7.5 h", "3.2 years".
+std::string readableSeconds(double s) {
+  if (!std::isfinite(s)) return formatApprox(s) + " s";
+  const struct {
+    double seconds;
+    const char* unit;
+  } units[] = {{365.25 * 86400.0, "years"}, {86400.0, "days"}, {3600.0, "h"}, {60.0, "min"}};
+  for (const auto& u : units)
+    if (s >= u.seconds) return formatApprox(s / u.seconds) + " " + u.unit;
+  return formatApprox(s) + " s";
+}
+
+}  // namespace
+
+void checkWork(double units, const std::string& unitName, double unitsPerSecond, bool allowed,
+               const std::string& remedy) {
+  const double seconds = units / unitsPerSecond;
+  if (allowed || seconds <= kMaxRunSeconds) return;
+  throw UsageError("the run would take about " + readableSeconds(seconds) + " (" +
+                   formatApprox(units) + " " + unitName + " at about " +
+                   formatApprox(unitsPerSecond) + " per second): more than the " +
+                   readableSeconds(kMaxRunSeconds) + " started without --allow-long-run; " +
+                   remedy + ", or give --allow-long-run");
+}
+
 void printSummary(const std::string& command, const std::string& what, const std::string& path,
                   const RunSummary& summary) {
   std::printf("%s: %s, %ld steps; wrote %s (%ld rows)\n", command.c_str(), what.c_str(),

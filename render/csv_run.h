@@ -93,6 +93,17 @@ long stepCount(double duration, double k, const std::string& durationFlag = "--d
 void checkOutputSize(long steps, long every, long columns,
                      const std::string& remedy = "raise --every or shorten --duration");
 
+// The longest run, in estimated seconds, hamiltone-sim starts without --allow-long-run.
+inline constexpr double kMaxRunSeconds = 3600.0;
+
+// Refuses (UsageError) a run whose estimated time exceeds kMaxRunSeconds, unless `allowed`
+// (--allow-long-run): `units` of work — steps × unknowns × quadrature nodes, named `unitName` —
+// at `unitsPerSecond`, a rate measured on one core of a 2-core CI machine (a faster machine
+// takes less; the estimate is for deciding, not a promise). The message prints the estimate and
+// `remedy`.
+void checkWork(double units, const std::string& unitName, double unitsPerSecond, bool allowed,
+               const std::string& remedy);
+
 // The lines a run prints on stdout (and its divergence warning on stderr).
 void printSummary(const std::string& command, const std::string& what, const std::string& path,
                   const RunSummary& summary);

@@ -44,7 +44,7 @@ class SimCliTest : public ::testing::Test {
 
   // `hamiltone-sim [SUBCOMMAND] ARGS` with stdin closed; the scratch directory is left as it was.
   CliResult run(const std::string& args) {
-    const std::string cmd = std::string(HAMILTONE_SIM) + " " + subcommand_ + args + " >" +
+    const std::string cmd = timeout_ + std::string(HAMILTONE_SIM) + " " + subcommand_ + args + " >" +
                             path("stdout") + " 2>" + path("stderr") + " </dev/null";
     const int status = std::system(cmd.c_str());
     CliResult r{WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(path("stdout")),
@@ -105,6 +105,9 @@ class SimCliTest : public ::testing::Test {
 
   std::filesystem::path dir_;
   std::string subcommand_;  // "wave ", "string ", …: put before every run's ARGS, if set
+  // "timeout 60 ": for a test whose command would run for ever where the code under test is
+  // wrong, so that it fails (exit 124) instead of hanging.
+  std::string timeout_;
 };
 
 }  // namespace hamiltone::test
