@@ -33,6 +33,7 @@ struct PlayArguments {
 };
 
 constexpr int kExitUsage = cli::kExitUsage;
+constexpr int kExitAudioLost = 3;  // the audio server or device went away while playing
 
 std::string describe(std::uint32_t m) {
   if (m == 0) return "-";
@@ -156,9 +157,14 @@ int play(const PlayArguments& a) {
                  a.api.c_str(), rate, buffer, 1000.0 * buffer / rate);
   timespec wait{0, 250'000'000};
   int signal = -1;
-  bool recordingFailureShown = false;
+  bool recordingFailureShown = false, lost = false;
   while (signal < 0) {
     signal = sigtimedwait(&stopSignals, nullptr, &wait);
+    // A server that went away (JACK shuts its clients down) leaves nothing to play on.
+    if (signal < 0 && audio.lost()) {
+      lost = true;
+      break;
+    }
     // A failed recording is said at once, on a line of its own; the sound plays on.
     if (recorder && recorder->failed() && !recordingFailureShown) {
       recordingFailureShown = true;
@@ -182,16 +188,23 @@ int play(const PlayArguments& a) {
   midi.close();
   const Player::Status s = player.status();
   if (status) std::fprintf(stderr, "\n");
-  std::fprintf(stderr,
-               "hamiltone-play: stopped by %s; underruns %ld; late callbacks %ld; peak cpu %.0f%%; "
-               "guard events %d\n",
-               signalName(signal).c_str(), audio.underruns(), s.late,
-               100.0 * s.peakLoad, s.guardEvents);
+  if (lost)
+    std::fprintf(stderr,
+                 "hamiltone-play: error: the audio stream is gone: %s; underruns %ld; late "
+                 "callbacks %ld; peak cpu %.0f%%; guard events %d\n",
+                 audio.lostReason().c_str(), audio.underruns(), s.late, 100.0 * s.peakLoad,
+                 s.guardEvents);
+  else
+    std::fprintf(stderr,
+                 "hamiltone-play: stopped by %s; underruns %ld; late callbacks %ld; peak cpu "
+                 "%.0f%%; guard events %d\n",
+                 signalName(signal).c_str(), audio.underruns(), s.late, 100.0 * s.peakLoad,
+                 s.guardEvents);
   if (recorder) {
     const double seconds = recorder->finish();
     if (!recorder->failed()) {
-      std::fprintf(stderr, "hamiltone-play: recorded %.2f s to %s%s%s\n", seconds,
-                   a.record.c_str(), s.recordDropped ? " (with gaps: the disk fell behind)" : "",
+      std::fprintf(stderr, "hamiltone-play: recorded %.2f s to %s%s%s\n", seconds, a.record.c_str(),
+                   s.recordDropped ? " (with gaps: the disk fell behind)" : "",
                    recorder->truncatedFrames() ? " (cut at the 4 GiB a WAV file holds)" : "");
     } else if (recorder->kept()) {
       std::fprintf(stderr,
@@ -205,6 +218,7 @@ int play(const PlayArguments& a) {
     }
     if (recorder->failed()) return 1;
   }
+  if (lost) return kExitAudioLost;
   // The signals meant to stop a program end it normally; another is reported as a shell would.
   return signal == SIGINT || signal == SIGTERM || signal == SIGHUP ? 0 : 128 + signal;
 }
@@ -241,9 +255,10 @@ int main(int argc, char** argv) {
       "Signals: SIGINT, SIGTERM and SIGHUP stop it normally; SIGUSR1, SIGPIPE, SIGALRM and the "
       "other signals that would end it stop it too, completing the recording, and exit 128+N; "
       "a signal ignored when it starts (nohup) stays ignored. "
-      "Exit codes: 0 stopped by SIGINT/SIGTERM/SIGHUP (the recording is complete), 1 an I/O error (a "
-      "recording that failed, e.g. on a full disk, keeps what was written before the error), "
-      "2 bad input or no usable audio API/device.");
+      "Exit codes: 0 stopped by SIGINT/SIGTERM/SIGHUP (the recording is complete), 1 an I/O error "
+      "(a recording that failed, e.g. on a full disk, keeps what was written before the error), "
+      "2 bad input or no usable audio API/device, 3 the audio server or device went away while "
+      "playing (the recording is complete up to then).");
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -311,9 +311,14 @@ class JackPlay : public ::testing::Test {
   // The player on that server, recording to `record`, with `extra` arguments; returns when it is
   // ready — its MIDI port exists, and the stream starts right after it is made.
   void startPlayer(const std::vector<std::string>& extra, const fs::path& record = {}) {
-    std::vector<std::string> argv = {HAMILTONE_PLAY, "--api",    "jack",
-                                     "--virtual-midi", "hamiltone-in", "--record",
-                                     (record.empty() ? wav() : record).string(), "--quiet"};
+    std::vector<std::string> argv = {HAMILTONE_PLAY,
+                                     "--api",
+                                     "jack",
+                                     "--virtual-midi",
+                                     "hamiltone-in",
+                                     "--record",
+                                     (record.empty() ? wav() : record).string(),
+                                     "--quiet"};
     argv.insert(argv.end(), extra.begin(), extra.end());
     spawn(player_, argv, "player");
     ASSERT_TRUE(player_->started());
@@ -481,29 +486,58 @@ std::vector<std::string> temporaries(const fs::path& dir) {
   return names;
 }
 
+// The player ends with `code` within 30 s, its stderr says `why` and that it recorded, and the
+// recording is a valid WAV of at least `frames` frames with no temporary beside it.
+void expectEndedWithTheRecording(std::optional<Child>& player, const fs::path& dir, int code,
+                                 const std::string& why, size_t frames) {
+  EXPECT_EQ(player->wait(30.0), code) << slurp(dir / "player.err");
+  const std::string err = slurp(dir / "player.err");
+  EXPECT_NE(err.find(why), std::string::npos) << err;
+  EXPECT_NE(err.find("recorded "), std::string::npos) << err;
+  SF_INFO info;
+  EXPECT_GE(readMono(dir / "out.wav", info).size(), frames) << "no valid recording";
+  EXPECT_TRUE(temporaries(dir).empty());
+}
+
 // Under nohup (SIGHUP inherited as ignored) a hang-up leaves the player playing; a signal that
 // would end it — here SIGUSR1 — stops it with the recording complete, exit 128 + N, no temporary.
 TEST_F(JackPlay, KeepsAnIgnoredHangupAndCompletesTheRecordingOnOtherSignals) {
   if (!onPath("jackd") || !onPath("jack_lsp"))
     GTEST_SKIP() << "jackd (Debian's jackd2) is not installed";
   ASSERT_NO_FATAL_FAILURE(startServer(false));
-  struct sigaction ignore {}, previous{};
+  struct sigaction ignore {
+  }, previous{};
   ignore.sa_handler = SIG_IGN;
   ::sigaction(SIGHUP, &ignore, &previous);  // inherited by the player, as under nohup
   startPlayer({"--preset", HAMILTONE_SOURCE_DIR "/presets/paper-c3-string.toml"});
   ::sigaction(SIGHUP, &previous, nullptr);
   ASSERT_FALSE(HasFatalFailure());
   player_->signal(SIGHUP);
-  EXPECT_FALSE(player_->wait(1.0)) << "a hang-up ended the player:\n"
-                                   << slurp(dir_ / "player.err");
+  EXPECT_FALSE(player_->wait(1.0)) << "a hang-up ended the player:\n" << slurp(dir_ / "player.err");
   player_->signal(SIGUSR1);
-  EXPECT_EQ(player_->wait(30.0), 128 + SIGUSR1);
-  const std::string err = slurp(dir_ / "player.err");
-  EXPECT_NE(err.find("stopped by SIGUSR1"), std::string::npos) << err;
-  EXPECT_NE(err.find("recorded "), std::string::npos) << err;
-  SF_INFO info;
-  EXPECT_GT(readMono(wav(), info).size(), 24000u) << "the second it played, less start-up";
-  EXPECT_TRUE(temporaries(dir_).empty());
+  expectEndedWithTheRecording(player_, dir_, 128 + SIGUSR1, "stopped by SIGUSR1",
+                              24000);  // 1 s, less start-up
+}
+
+// The JACK server going away mid-performance — stopped (SIGTERM) or killed (SIGKILL): the player
+// notices (JACK shuts its clients down and RtAudio closes the stream), completes the recording up
+// to then, says why and exits 3, instead of running on in silence.
+TEST_F(JackPlay, ALostServerEndsThePlayerWithTheRecordingComplete) {
+  if (!onPath("jackd") || !onPath("jack_lsp"))
+    GTEST_SKIP() << "jackd (Debian's jackd2) is not installed";
+  for (const int signal : {SIGTERM, SIGKILL}) {
+    SCOPED_TRACE(::strsignal(signal));
+    stopAll();
+    useServer(name_ + "-lost-" + std::to_string(signal));
+    ASSERT_NO_FATAL_FAILURE(startServer(false));
+    ASSERT_NO_FATAL_FAILURE(
+        startPlayer({"--preset", HAMILTONE_SOURCE_DIR "/presets/paper-c3-string.toml"}));
+    std::this_thread::sleep_for(500ms);  // something to record
+    jackd_->signal(signal);
+    jackd_->wait(10.0);
+    expectEndedWithTheRecording(player_, dir_, 3, "the audio stream is gone", 1);
+    fs::remove(wav());
+  }
 }
 
 TEST_F(JackPlay, WithoutAServerRefusesInOneLineWithExitCode2) {
