@@ -45,7 +45,7 @@ class Recorder {
   SpscQueue<float> ring_;
   std::thread writer_;
   std::atomic<bool> stopping_{false}, failed_{false};
-  std::string error_;     // written before failed_ is set (release), read after (acquire)
+  std::string error_;      // written before failed_ is set (release), read after (acquire)
   double failedAt_ = 0.0;  // likewise
   long frames_ = 0, truncated_ = 0;
   int sampleRate_;

@@ -15,9 +15,8 @@ long stepCount(double duration, double k, const std::string& durationFlag,
   if (steps > kMaxSteps)
     throw UsageError(durationFlag + " / " + stepFlag + " = " + formatApprox(duration / k) +
                      " steps (" + durationFlag + " = " + formatNumber(duration) + " s, " +
-                     stepFlag + " = " + formatNumber(k) +
-                     " s): expected at most 1e10; shorten " + durationFlag + " or raise " +
-                     stepFlag);
+                     stepFlag + " = " + formatNumber(k) + " s): expected at most 1e10; shorten " +
+                     durationFlag + " or raise " + stepFlag);
   return static_cast<long>(steps);
 }
 

@@ -239,10 +239,11 @@ int runFpuCommand(const FpuArguments& a) {
   checkOutputSize(steps, every, 2 * pairs + 4);
   // A step moves 2M particles (a Marazzato step evaluates the forces at each quadrature node).
   // Measured: 3e8 particle-steps a second for sv, sav and sav-split at 2e4 particles.
-  const double nodes =
-      a.scheme != "marazzato" ? 1.0
-      : static_cast<double>(nodesPerInterval(quadrature(
-            a.quadrature.empty() ? QuadratureRule::midpoint : *parseQuadratureRule(a.quadrature))));
+  const double nodes = a.scheme != "marazzato"
+                           ? 1.0
+                           : static_cast<double>(nodesPerInterval(quadrature(
+                                 a.quadrature.empty() ? QuadratureRule::midpoint
+                                                      : *parseQuadratureRule(a.quadrature))));
   checkWork(static_cast<double>(steps) * 2.0 * static_cast<double>(pairs), "particle-steps",
             3e8 / nodes, a.allowLongRun, "shorten --duration, raise --k or lower --pairs");
 

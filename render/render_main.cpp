@@ -159,7 +159,8 @@ int main(int argc, char** argv) {
                  "\"C3:100:2.0, E3@0.5:90:1.5\" (C4 = MIDI 60; START 0, VELOCITY 100 and "
                  "DURATION 1 s by default)")
       ->type_name("LIST");
-  app.add_option("-o,--out", a.out, "WAV file to write (replaced whole, or untouched on error); not an input file")
+  app.add_option("-o,--out", a.out,
+                 "WAV file to write (replaced whole, or untouched on error); not an input file")
       ->type_name("FILE");
   addNumberOption(&app, "--sample-rate", a.sampleRate, "HZ", "sample rate, 8000 … 384000");
   app.add_option("--format", a.format, "sample format")
@@ -173,8 +174,9 @@ int main(int argc, char** argv) {
                "print every preset parameter (name, type, unit, range, default) and exit");
   app.footer(
       "Exit codes: 0 done, 1 an I/O error (no file is left), 2 bad input (arguments, preset or "
-      "MIDI file, or a preset found unstable for the notes played; no file is written), 128+N ended by signal N (no file left; a signal ignored "
-      "when it starts, as under nohup, stays ignored).");
+      "MIDI file, or a preset found unstable for the notes played; no file is written), 128+N "
+      "ended by signal N (no file left; a signal ignored when it starts, as under nohup, stays "
+      "ignored).");
 
   try {
     app.parse(argc, argv);

@@ -183,8 +183,8 @@ int runWaveCommand(const WaveArguments& a) {
   // Each step evaluates every element's force at each quadrature node; an adaptive run takes at
   // least the fixed run's steps (its step never exceeds --k). Measured: about 3e7 element-steps a
   // second at one node (midpoint, 1000 elements).
-  const double nodes = static_cast<double>(
-      nodesPerInterval(quadrature(*parseQuadratureRule(a.quadrature))));
+  const double nodes =
+      static_cast<double>(nodesPerInterval(quadrature(*parseQuadratureRule(a.quadrature))));
   checkWork(static_cast<double>(steps) * elements, "element-steps", 3e7 / nodes, a.allowLongRun,
             "shorten --duration, raise --k or --dx");
   AdaptiveStep adaptive{.enabled = a.adaptive, .growAfter = kGrowAfter};

@@ -15,8 +15,8 @@ inline int segmentsAlong(double length, double h, double k, double maximum, cons
                          const std::string& rule) {
   if (!(h > 0.0) || !std::isfinite(h))
     throw std::invalid_argument(
-        what + " = " + formatNumber(length) + " m: the grid spacing h (" + rule + ") at k = " +
-        formatApprox(k) + " s is " + formatApprox(h) +
+        what + " = " + formatNumber(length) + " m: the grid spacing h (" + rule +
+        ") at k = " + formatApprox(k) + " s is " + formatApprox(h) +
         ": a material parameter or the step is beyond what double precision holds; expected "
         "values of physical size");
   const double segments = std::floor(length / h);

@@ -20,8 +20,8 @@ class PlayCli : public hamiltone::test::SimCliTest {
   // `hamiltone-play ARGS` on a JACK server name no server has, so no device is ever opened.
   hamiltone::test::CliResult play(const std::string& args) {
     const std::string cmd = "JACK_DEFAULT_SERVER=hamiltone-no-server-" +
-                            std::to_string(::getpid()) + " " HAMILTONE_PLAY " " + args +
-                            " >" + path("stdout") + " 2>" + path("stderr") + " </dev/null";
+                            std::to_string(::getpid()) + " " HAMILTONE_PLAY " " + args + " >" +
+                            path("stdout") + " 2>" + path("stderr") + " </dev/null";
     const int status = std::system(cmd.c_str());
     hamiltone::test::CliResult r{WIFEXITED(status) ? WEXITSTATUS(status) : -1,
                                  slurp(path("stdout")), slurp(path("stderr"))};

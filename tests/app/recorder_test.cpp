@@ -138,7 +138,8 @@ TEST_F(RecorderTest, AFileThatCannotBeFinalisedIsRemoved) {
     recorder.start();
     ASSERT_TRUE(push(recorder, 0, kRate / 10));
     ASSERT_TRUE(waitUntilFailed(recorder));
-    EXPECT_TRUE(push(recorder, kRate / 10, static_cast<size_t>(2 * Recorder::kRingSeconds * kRate)));
+    EXPECT_TRUE(
+        push(recorder, kRate / 10, static_cast<size_t>(2 * Recorder::kRingSeconds * kRate)));
     EXPECT_EQ(recorder.finish(), 0.0);
     EXPECT_FALSE(recorder.kept());
     EXPECT_NE(recorder.error().find("take.wav"), std::string::npos) << recorder.error();

@@ -113,9 +113,9 @@ TEST_F(RenderCli, TwoRendersAreTheSameBytesInEveryFormat) {
   for (const char* format : {"pcm16", "pcm24", "float32"}) {
     std::string bytes[2];
     for (std::string& b : bytes) {
-      const Result r = run("--preset " + preset("paper-c3-string") +
-                           " --notes C3:100:0.1 --tail 0 --quiet --format " + format + " -o " +
-                           wav());
+      const Result r =
+          run("--preset " + preset("paper-c3-string") +
+              " --notes C3:100:0.1 --tail 0 --quiet --format " + format + " -o " + wav());
       ASSERT_EQ(r.exitCode, 0) << r.err;
       b = hamiltone::testing::fileBytes(wav());
     }
@@ -123,7 +123,8 @@ TEST_F(RenderCli, TwoRendersAreTheSameBytesInEveryFormat) {
     const std::vector<std::string> ids = hamiltone::testing::riffChunkIds(bytes[0]);
     ASSERT_FALSE(ids.empty()) << format;
     for (const std::string& id : ids)
-      EXPECT_TRUE(id == "fmt " || id == "fact" || id == "PAD " || id == "data") << format << ": chunk " << id;
+      EXPECT_TRUE(id == "fmt " || id == "fact" || id == "PAD " || id == "data")
+          << format << ": chunk " << id;
   }
 }
 
@@ -225,7 +226,8 @@ TEST_F(RenderCli, AnUnstablePresetIsAnErrorAndWritesNothing) {
   text.replace(text.find(was), was.size(), "epsilon_J = 1e6 ");
   const fs::path unstable = dir_ / "unstable.toml";
   std::ofstream(unstable) << text;
-  const Result r = run("--preset " + unstable.string() + " --notes C3:127:0.5 --tail 0 -o " + wav());
+  const Result r =
+      run("--preset " + unstable.string() + " --notes C3:127:0.5 --tail 0 -o " + wav());
   EXPECT_EQ(r.exitCode, 2) << r.err;
   EXPECT_NE(r.err.find("unstable.toml"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("epsilon_J"), std::string::npos) << r.err;

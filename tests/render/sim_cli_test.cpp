@@ -184,16 +184,19 @@ TEST_F(SimCli, MessagesNameTheFlagAtFaultWithReadableNumbers) {
 // --allow-long-run lifts the limit (here the next check, an unwritable --out, then speaks).
 TEST_F(SimCli, RefusesARunThatWouldTakeTooLongUnlessAllowed) {
   timeout_ = "timeout 120 ";
-  const std::string fpu = "fpu --scheme sav --pairs 1000000 --k 1e-6 --duration 100 --every 1000000000";
+  const std::string fpu =
+      "fpu --scheme sav --pairs 1000000 --k 1e-6 --duration 100 --every 1000000000";
   const std::string wave = "wave --dx 1e-6 --k 1e-7 --duration 10 --every 1000000000";
   for (const std::string& args : {fpu, wave}) {
     for (const char* mention : {"days", "--allow-long-run", "per second"})
       expectRefused(args + " --out " + path("out.csv"), mention);
     expectRefused(args + " --allow-long-run --out " + path("no-dir/out.csv"), "--out");
   }
-  expectRefused("fpu --scheme marazzato --quadrature gl5 --pairs 1000000 --k 1e-3 --duration 1000 "
-                "--every 1000000000 --out " + path("out.csv"),
-                "--allow-long-run");
+  expectRefused(
+      "fpu --scheme marazzato --quadrature gl5 --pairs 1000000 --k 1e-3 --duration 1000 "
+      "--every 1000000000 --out " +
+          path("out.csv"),
+      "--allow-long-run");
 }
 
 TEST_F(SimCli, InterruptedRunLeavesNoFile) {

@@ -44,8 +44,8 @@ class SimCliTest : public ::testing::Test {
 
   // `hamiltone-sim [SUBCOMMAND] ARGS` with stdin closed; the scratch directory is left as it was.
   CliResult run(const std::string& args) {
-    const std::string cmd = timeout_ + std::string(HAMILTONE_SIM) + " " + subcommand_ + args + " >" +
-                            path("stdout") + " 2>" + path("stderr") + " </dev/null";
+    const std::string cmd = timeout_ + std::string(HAMILTONE_SIM) + " " + subcommand_ + args +
+                            " >" + path("stdout") + " 2>" + path("stderr") + " </dev/null";
     const int status = std::system(cmd.c_str());
     CliResult r{WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(path("stdout")),
                 slurp(path("stderr"))};
