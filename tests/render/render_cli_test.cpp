@@ -16,6 +16,7 @@
 
 #include "support/riff_chunks.h"
 #include "support/spectrum.h"
+#include "support/tiny_disk.h"
 
 namespace {
 
@@ -233,6 +234,20 @@ TEST_F(RenderCli, AnUnstablePresetIsAnErrorAndWritesNothing) {
   EXPECT_NE(r.err.find("epsilon_J"), std::string::npos) << r.err;
   for (const auto& entry : fs::directory_iterator(dir_))  // the preset, no WAV, no temporary
     EXPECT_EQ(entry.path().filename().string().find("out.wav"), std::string::npos);
+}
+
+// A full disk is an I/O error: exit 1, the message names the file, and neither it nor a temporary
+// is left (docs/failure-behaviour.md). 1 s of pcm24 stereo is 288 kB, more than the 64 KiB disk.
+TEST_F(RenderCli, AFullDiskIsAnIoErrorAndLeavesNoFile) {
+  const fs::path full = dir_ / "full";
+  hamiltone::test::TinyDisk disk(full);
+  if (!disk.mounted()) GTEST_SKIP() << "cannot mount a 64 KiB tmpfs here (needs root)";
+  const fs::path out = full / "out.wav";
+  const Result r = run("--preset " + preset("paper-c3-string") +
+                       " --notes C3 --tail 0 --quiet -o " + out.string());
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_NE(r.err.find(out.string()), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::is_empty(full));
 }
 
 TEST_F(RenderCli, ListsTheParameterTable) {
