@@ -37,6 +37,7 @@
 extern char** environ;
 
 #include "support/spectrum.h"
+#include "support/tiny_disk.h"
 
 namespace {
 
@@ -537,7 +538,40 @@ TEST_F(JackPlay, ALostServerEndsThePlayerWithTheRecordingComplete) {
     jackd_->wait(10.0);
     expectEndedWithTheRecording(player_, dir_, 3, "the audio stream is gone", 1);
     fs::remove(wav());
+    // A killed server leaves its entry in JACK's registry of servers (at most 8, per machine, all
+    // users): a server of the same name reclaims it, and stopping that one frees it.
+    if (signal == SIGKILL) {
+      ASSERT_NO_FATAL_FAILURE(startServer(false));
+      jackd_->signal(SIGTERM);
+      EXPECT_EQ(jackd_->wait(10.0), 0) << slurp(dir_ / "jackd.err");
+    }
   }
+}
+
+// Recording onto a disk that fills (a 64 KiB tmpfs: 0.23 s of 24-bit stereo at 48 kHz): the
+// player says the recording stopped, plays on, and on SIGINT keeps the WAV up to the error and
+// exits 1 — where it aborted (exit 134) and left its temporary.
+TEST_F(JackPlay, AFullDiskStopsTheRecordingNotThePlayer) {
+  if (!onPath("jackd") || !onPath("jack_lsp"))
+    GTEST_SKIP() << "jackd (Debian's jackd2) is not installed";
+  const fs::path full = dir_ / "full";
+  hamiltone::test::TinyDisk disk(full);
+  if (!disk.mounted()) GTEST_SKIP() << "cannot mount a 64 KiB tmpfs here (needs root)";
+  ASSERT_NO_FATAL_FAILURE(startServer(false));
+  ASSERT_NO_FATAL_FAILURE(startPlayer(
+      {"--preset", HAMILTONE_SOURCE_DIR "/presets/paper-c3-string.toml"}, full / "take.wav"));
+  for (int i = 0;
+       i < 300 && slurp(dir_ / "player.err").find("recording stopped") == std::string::npos; ++i)
+    std::this_thread::sleep_for(100ms);
+  EXPECT_FALSE(player_->wait(0.5)) << "the player ended:\n" << slurp(dir_ / "player.err");
+  player_->signal(SIGINT);
+  EXPECT_EQ(player_->wait(30.0), 1) << slurp(dir_ / "player.err");
+  const std::string err = slurp(dir_ / "player.err");
+  EXPECT_NE(err.find("recording stopped at"), std::string::npos) << err;
+  EXPECT_NE(err.find("holds the"), std::string::npos) << err;
+  SF_INFO info;
+  EXPECT_GT(readMono(full / "take.wav", info).size(), 4800u) << "no valid recording";
+  EXPECT_TRUE(temporaries(full).empty());
 }
 
 TEST_F(JackPlay, WithoutAServerRefusesInOneLineWithExitCode2) {
