@@ -5,6 +5,7 @@
 #include <RtAudio.h>
 
 #include <atomic>
+#include <cstdio>
 
 #include "quiet_stderr.h"
 
@@ -14,9 +15,24 @@ struct AudioOutput::Impl {
   std::unique_ptr<RtAudio> audio;
   Render render;
   std::atomic<long> underruns{0};
+  bool started = false, stopped = false;  // main thread only
+  std::atomic<bool> failed{false};        // set by RtAudio's error callback
+  char failure[256] = {};                 // its message, written before `failed` is set
 };
 
 namespace {
+
+// RtAudio 5's error callback has no user pointer: the one open stream's Impl, for it.
+std::atomic<AudioOutput::Impl*> errorSink{nullptr};
+
+// Called by RtAudio on its own threads for a stream error (not on the real-time path).
+void streamError(RtAudioError::Type type, const std::string& text) {
+  if (type == RtAudioError::WARNING || type == RtAudioError::DEBUG_WARNING) return;
+  AudioOutput::Impl* impl = errorSink.load();
+  if (!impl || impl->failed.load()) return;
+  std::snprintf(impl->failure, sizeof impl->failure, "%s", text.c_str());
+  impl->failed.store(true);
+}
 
 int callback(void* out, void*, unsigned frames, double, RtAudioStreamStatus status, void* user) {
   auto* impl = static_cast<AudioOutput::Impl*>(user);
@@ -66,6 +82,8 @@ AudioOutput::AudioOutput(const std::string& api) : impl_(std::make_unique<Impl>(
 }
 
 AudioOutput::~AudioOutput() {
+  AudioOutput::Impl* self = impl_.get();
+  errorSink.compare_exchange_strong(self, nullptr);
   try {
     stop();
     if (impl_->audio && impl_->audio->isStreamOpen()) impl_->audio->closeStream();
@@ -118,8 +136,9 @@ void AudioOutput::open(int device, unsigned sampleRate, unsigned& bufferFrames, 
   options.flags = RTAUDIO_SCHEDULE_REALTIME;
   try {
     const QuietStderr quiet;
+    errorSink.store(impl_.get());
     impl_->audio->openStream(&out, nullptr, RTAUDIO_FLOAT32, sampleRate, &bufferFrames, &callback,
-                             impl_.get(), &options);
+                             impl_.get(), &options, &streamError);
   } catch (const RtAudioError& e) {
     throw AudioError("cannot open device " + std::to_string(chosen) + " of API " + api_ + " at " +
                      std::to_string(sampleRate) + " Hz: " + e.getMessage() +
@@ -130,16 +149,29 @@ void AudioOutput::open(int device, unsigned sampleRate, unsigned& bufferFrames, 
 void AudioOutput::start() {
   try {
     impl_->audio->startStream();
+    impl_->started = true;
   } catch (const RtAudioError& e) {
     throw AudioError("cannot start the audio stream: " + e.getMessage());
   }
 }
 
 void AudioOutput::stop() {
+  impl_->stopped = true;
   if (impl_->audio && impl_->audio->isStreamOpen() && impl_->audio->isStreamRunning())
     impl_->audio->stopStream();
 }
 
 long AudioOutput::underruns() const { return impl_->underruns.load(); }
+
+bool AudioOutput::lost() const {
+  if (!impl_->started || impl_->stopped) return false;
+  return impl_->failed.load() || !impl_->audio->isStreamOpen() || !impl_->audio->isStreamRunning();
+}
+
+std::string AudioOutput::lostReason() const {
+  if (impl_->failed.load()) return impl_->failure;
+  return api_ == "jack" ? "the JACK server shut this client down (it stopped, or went away)"
+                        : "the audio stream stopped by itself (the device went away?)";
+}
 
 }  // namespace hamiltone::app

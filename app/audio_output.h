@@ -42,6 +42,11 @@ class AudioOutput {
   void start();
   void stop();  // waits for the callback to finish; safe to call twice
   long underruns() const;
+  // Whether the started stream ended without stop(): the server went away (JACK shuts its clients
+  // down, and RtAudio then closes the stream) or RtAudio reported an error. From the main thread,
+  // polled; lostReason() says what happened.
+  bool lost() const;
+  std::string lostReason() const;
   std::string api() const { return api_; }
 
   struct Impl;  // RtAudio's, and what its C callback reaches

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "atomic_file.h"
 #include "audio_output.h"
 #include "midi_input.h"
 #include "number_arguments.h"
@@ -32,6 +33,7 @@ struct PlayArguments {
 };
 
 constexpr int kExitUsage = cli::kExitUsage;
+constexpr int kExitAudioLost = 3;  // the audio server or device went away while playing
 
 std::string describe(std::uint32_t m) {
   if (m == 0) return "-";
@@ -57,6 +59,11 @@ std::string describe(std::uint32_t m) {
       std::snprintf(text, sizeof text, "%02X %d %d", status, d1, d2);
   }
   return text;
+}
+
+std::string signalName(int signal) {
+  const char* abbreviation = ::sigabbrev_np(signal);
+  return abbreviation ? std::string("SIG") + abbreviation : "signal " + std::to_string(signal);
 }
 
 int listDevices(const std::string& api) {
@@ -86,12 +93,22 @@ int play(const PlayArguments& a) {
   const int voices =
       a.voices.empty() ? 0 : static_cast<int>(cli::parseInteger("--voices", a.voices, 1, 128));
 
-  // SIGINT and SIGTERM are taken by this thread alone (sigtimedwait below); every thread started
-  // from here on — audio, MIDI, the recorder — inherits the mask.
+  std::vector<cli::InputFile> inputs;
+  for (const std::string& file : a.presets) inputs.push_back({"--preset", file});
+  if (a.presets.empty()) inputs.push_back({"--preset (the default)", HAMILTONE_DEFAULT_PRESET});
+  cli::refuseInputAsOutput("--record", a.record, inputs);
+
+  // Every signal that would end the program stops it instead, completing the recording: they are
+  // taken by this thread alone (sigtimedwait below), and every thread started from here on —
+  // audio, MIDI, the recorder — inherits the mask. A signal inherited as ignored (nohup's
+  // SIGHUP) is left out: blocked, Linux would queue it for sigtimedwait rather than drop it.
   sigset_t stopSignals;
   sigemptyset(&stopSignals);
-  sigaddset(&stopSignals, SIGINT);
-  sigaddset(&stopSignals, SIGTERM);
+  for (const int s : cli::AtomicFile::kEndingSignals) {
+    struct sigaction current {};
+    if (::sigaction(s, nullptr, &current) == 0 && current.sa_handler != SIG_IGN)
+      sigaddset(&stopSignals, s);
+  }
   pthread_sigmask(SIG_BLOCK, &stopSignals, nullptr);
 
   // Presets load and their voices are built here, off the audio thread; program change then only
@@ -130,33 +147,70 @@ int play(const PlayArguments& a) {
                  a.api.c_str(), rate, buffer, 1000.0 * buffer / rate);
   timespec wait{0, 250'000'000};
   int signal = -1;
+  bool recordingFailureShown = false, lost = false;
   while (signal < 0) {
     signal = sigtimedwait(&stopSignals, nullptr, &wait);
+    // A server that went away (JACK shuts its clients down) leaves nothing to play on.
+    if (signal < 0 && audio.lost()) {
+      lost = true;
+      break;
+    }
+    // A failed recording is said at once, on a line of its own; the sound plays on.
+    if (recorder && recorder->failed() && !recordingFailureShown) {
+      recordingFailureShown = true;
+      std::fprintf(stderr,
+                   "%shamiltone-play: recording stopped at %.2f s: %s; still playing (the %.2f s "
+                   "written are kept at exit)\n",
+                   status ? "\n" : "", recorder->failedAtSeconds(), recorder->error().c_str(),
+                   recorder->failedAtSeconds());
+    }
     if (!status) continue;
     const Player::Status s = player.status();
     std::fprintf(stderr,
                  "\r  voices %2d/%-3d  cpu %3.0f%% (peak %3.0f%%)  underruns %ld (late %ld)  "
-                 "midi %-12s  guard %d   ",
+                 "midi %-12s  guard %d%s   ",
                  s.voices, s.limit, 100.0 * s.load, 100.0 * s.peakLoad, audio.underruns(), s.late,
-                 describe(s.lastMessage).c_str(), s.guardEvents);
+                 describe(s.lastMessage).c_str(), s.guardEvents,
+                 recordingFailureShown ? "  REC STOPPED" : "");
     std::fflush(stderr);
   }
   audio.stop();
   midi.close();
   const Player::Status s = player.status();
   if (status) std::fprintf(stderr, "\n");
-  std::fprintf(stderr,
-               "hamiltone-play: stopped by %s; underruns %ld; late callbacks %ld; peak cpu %.0f%%; "
-               "guard events %d\n",
-               signal == SIGINT ? "SIGINT" : "SIGTERM", audio.underruns(), s.late,
-               100.0 * s.peakLoad, s.guardEvents);
+  if (lost)
+    std::fprintf(stderr,
+                 "hamiltone-play: error: the audio stream is gone: %s; underruns %ld; late "
+                 "callbacks %ld; peak cpu %.0f%%; guard events %d\n",
+                 audio.lostReason().c_str(), audio.underruns(), s.late, 100.0 * s.peakLoad,
+                 s.guardEvents);
+  else
+    std::fprintf(stderr,
+                 "hamiltone-play: stopped by %s; underruns %ld; late callbacks %ld; peak cpu "
+                 "%.0f%%; guard events %d\n",
+                 signalName(signal).c_str(), audio.underruns(), s.late, 100.0 * s.peakLoad,
+                 s.guardEvents);
   if (recorder) {
     const double seconds = recorder->finish();
-    std::fprintf(stderr, "hamiltone-play: recorded %.2f s to %s%s%s\n", seconds, a.record.c_str(),
-                 s.recordDropped ? " (with gaps: the disk fell behind)" : "",
-                 recorder->truncatedFrames() ? " (cut at the 4 GiB a WAV file holds)" : "");
+    if (!recorder->failed()) {
+      std::fprintf(stderr, "hamiltone-play: recorded %.2f s to %s%s%s\n", seconds, a.record.c_str(),
+                   s.recordDropped ? " (with gaps: the disk fell behind)" : "",
+                   recorder->truncatedFrames() ? " (cut at the 4 GiB a WAV file holds)" : "");
+    } else if (recorder->kept()) {
+      std::fprintf(stderr,
+                   "hamiltone-play: error: the recording stopped at %.2f s (%s); %s holds the "
+                   "%.2f s written before\n",
+                   recorder->failedAtSeconds(), recorder->error().c_str(), a.record.c_str(),
+                   seconds);
+    } else {
+      std::fprintf(stderr, "hamiltone-play: error: the recording failed (%s); no file written\n",
+                   recorder->error().c_str());
+    }
+    if (recorder->failed()) return 1;
   }
-  return 0;
+  if (lost) return kExitAudioLost;
+  // The signals meant to stop a program end it normally; another is reported as a shell would.
+  return signal == SIGINT || signal == SIGTERM || signal == SIGHUP ? 0 : 128 + signal;
 }
 
 }  // namespace
@@ -189,8 +243,13 @@ int main(int argc, char** argv) {
   app.add_flag("--list-devices", a.listDevices, "list the APIs, output devices and MIDI ports");
   app.add_flag("--quiet", a.quiet, "no status line");
   app.footer(
-      "Exit codes: 0 stopped by SIGINT/SIGTERM (the recording is complete), 1 an I/O error, "
-      "2 bad input or no usable audio API/device.");
+      "Signals: SIGINT, SIGTERM and SIGHUP stop it normally; SIGUSR1, SIGPIPE, SIGALRM and the "
+      "other signals that would end it stop it too, completing the recording, and exit 128+N; "
+      "a signal ignored when it starts (nohup) stays ignored. "
+      "Exit codes: 0 stopped by SIGINT/SIGTERM/SIGHUP (the recording is complete), 1 an I/O error "
+      "(a recording that failed, e.g. on a full disk, keeps what was written before the error), "
+      "2 bad input or no usable audio API/device, 3 the audio server or device went away while "
+      "playing (the recording is complete up to then).");
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -1,8 +1,10 @@
-// The recorder's writer thread: it empties the ring every 10 ms into the WAV writer.
+// The recorder's writer thread: it empties the ring every 10 ms into the WAV writer, and after a
+// write error into nothing.
 #include "recorder.h"
 
 #include <algorithm>
 #include <chrono>
+#include <exception>
 #include <vector>
 
 namespace hamiltone::app {
@@ -33,22 +35,39 @@ void Recorder::drain() {
   std::vector<float> chunk(8192);
   size_t n;
   while ((n = ring_.pop(chunk.data(), chunk.size())) > 0) {
+    if (failed_.load(std::memory_order_relaxed)) continue;  // emptied, so the audio goes on
     // Frames (the audio thread pushes whole ones), up to what a WAV file can hold: 4 GiB of
     // 24-bit stereo, 4.1 h at 48 kHz; the rest is dropped and counted.
     const long frames = std::min(static_cast<long>(n / 2), kMaxFrames - frames_);
-    if (frames > 0) wav_.write(chunk.data(), static_cast<size_t>(frames));
+    try {
+      if (frames > 0) wav_.write(chunk.data(), static_cast<size_t>(frames));
+    } catch (const std::exception& e) {
+      frames_ = static_cast<long>(wav_.framesWritten());
+      failedAt_ = static_cast<double>(frames_) / sampleRate_;
+      error_ = e.what();
+      failed_.store(true, std::memory_order_release);
+      continue;
+    }
     frames_ += std::max(frames, 0L);
     truncated_ += static_cast<long>(n / 2) - std::max(frames, 0L);
   }
 }
 
-double Recorder::finish() {
-  if (finished_) return static_cast<double>(frames_) / sampleRate_;
-  stopping_ = true;
-  if (writer_.joinable()) writer_.join();
-  wav_.commit();
-  finished_ = true;
-  return static_cast<double>(frames_) / sampleRate_;
+double Recorder::finish() noexcept {
+  if (!finished_) {
+    stopping_ = true;
+    if (writer_.joinable()) writer_.join();
+    finished_ = true;
+    try {
+      wav_.commit();
+      kept_ = true;
+    } catch (const std::exception& e) {
+      // The temporary goes with wav_; say why, after the first error if there was one.
+      error_ = failed() ? error_ + "; then " + e.what() : std::string(e.what());
+      failed_.store(true, std::memory_order_release);
+    }
+  }
+  return kept_ ? static_cast<double>(frames_) / sampleRate_ : 0.0;
 }
 
 }  // namespace hamiltone::app

@@ -1,6 +1,7 @@
 // --record: the exact output, teed by the audio thread into a lock-free ring and written to a WAV
 // file by a thread of its own. The file appears whole when the recorder finishes (on a normal
-// stop or on Ctrl-C), never half-written.
+// stop or on Ctrl-C), never half-written. A write error (a full disk) stops the recording, not
+// the sound: the writer then discards what comes, and finish() keeps what was written before.
 #pragma once
 
 #include <atomic>
@@ -22,10 +23,20 @@ class Recorder {
   ~Recorder();  // finish() if not done
   SpscQueue<float>& ring() { return ring_; }
   void start();
-  // Stops the writer once the ring is drained and renames the file into place. Returns the
-  // seconds recorded.
-  double finish();
+  // Stops the writer once the ring is drained and renames the file into place: after a write
+  // error, the frames written before it (a valid WAV), or no file if even that fails (then the
+  // temporary is removed). Never throws. Returns the seconds in the file (0 when there is none).
+  double finish() noexcept;
   long truncatedFrames() const { return truncated_; }  // past kMaxFrames, not written
+
+  // Whether a write failed; from any thread. The recording stopped there.
+  bool failed() const { return failed_.load(std::memory_order_acquire); }
+  // Once failed(): where (seconds into the recording) and why, naming the file.
+  double failedAtSeconds() const { return failedAt_; }
+  const std::string& error() const { return error_; }
+  // After finish(): whether the file is in place.
+  bool kept() const { return kept_; }
+  const std::string& path() const { return wav_.path(); }
 
  private:
   void drain();
@@ -33,10 +44,12 @@ class Recorder {
   cli::WavWriter wav_;
   SpscQueue<float> ring_;
   std::thread writer_;
-  std::atomic<bool> stopping_{false};
+  std::atomic<bool> stopping_{false}, failed_{false};
+  std::string error_;      // written before failed_ is set (release), read after (acquire)
+  double failedAt_ = 0.0;  // likewise
   long frames_ = 0, truncated_ = 0;
   int sampleRate_;
-  bool finished_ = false;
+  bool finished_ = false, kept_ = false;
 };
 
 }  // namespace hamiltone::app

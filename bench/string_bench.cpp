@@ -45,15 +45,10 @@ constexpr Note kNotes[] = {{21, "A0"}, {48, "C3"}, {84, "C6"}};
 constexpr GridRule kGrids[] = {GridRule::twoGrid, GridRule::transverse, GridRule::longitudinal};
 constexpr int kOversampling[] = {1, 4};
 
-const char* gridName(GridRule g) {
-  return g == GridRule::twoGrid      ? "two-grid"
-         : g == GridRule::transverse ? "transverse"
-                                     : "longitudinal";
-}
 
 std::string voiceName(const Note& note, GridRule grid, int oversampling, bool lossless) {
   return std::string("StringVoice/") + note.name + "_" + std::to_string(note.midi) + "/" +
-         gridName(grid) + "/os:" + std::to_string(oversampling) + (lossless ? "/lossless" : "");
+         gridRuleName(grid) + "/os:" + std::to_string(oversampling) + (lossless ? "/lossless" : "");
 }
 
 struct VoiceCase {
@@ -77,7 +72,7 @@ void processVoice(benchmark::State& state, VoiceCase c) {
     // The longitudinal grid asks h >= sqrt(E/ρ) k: at 48 kHz that is ~0.1 m, more than half of a
     // treble string, so its voice cannot be built without oversampling.
     const std::string why = std::string("no voice for ") + c.note.name + " on the " +
-                            gridName(c.grid) + " grid at oversampling " +
+                            gridRuleName(c.grid) + " grid at oversampling " +
                             std::to_string(c.oversampling) + ": " + e.what();
     state.SkipWithError(why.c_str());
     return;
@@ -214,13 +209,13 @@ void printVoices(const RecordingReporter& reporter) {
     const std::string name = voiceName(note, grid, os, lossless);
     const RecordingReporter::Record* r = reporter.find(name);
     if (r == nullptr) {
-      std::printf("%-4s %-12s %3d %-9s %s\n", note.name, gridName(grid), os,
+      std::printf("%-4s %-12s %3d %-9s %s\n", note.name, gridRuleName(grid), os,
                   lossless ? "lossless" : "patch", "(filtered out or skipped: see the table)");
       return;
     }
     const double nsPerSample = r->seconds / kBlock * 1e9;
     const double unknowns = r->counters.at("unknowns").value;
-    std::printf("%-4s %-12s %3d %-9s %8.0f %9.0f %10.1f %8.2f %16.3f\n", note.name, gridName(grid),
+    std::printf("%-4s %-12s %3d %-9s %8.0f %9.0f %10.1f %8.2f %16.3f\n", note.name, gridRuleName(grid),
                 os, lossless ? "lossless" : "patch", r->counters.at("segments").value, unknowns,
                 nsPerSample, 100.0 * nsPerSample * kSampleRate / 1e9,
                 nsPerSample / (os * unknowns));

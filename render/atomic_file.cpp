@@ -12,13 +12,19 @@
 #include <csignal>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <mutex>
 #include <stdexcept>
+#include <system_error>
 #include <vector>
 
 #include "usage_error.h"
 
 namespace hamiltone::cli {
+
+// SIGXFSZ: past the file-size limit (ulimit -f). Not SIGQUIT, whose core dump is wanted as is.
+const int AtomicFile::kEndingSignals[12] = {SIGHUP,  SIGINT,    SIGTERM, SIGUSR1, SIGUSR2, SIGPIPE,
+                                            SIGALRM, SIGVTALRM, SIGPROF, SIGXCPU, SIGXFSZ, SIGPOLL};
 
 namespace {
 
@@ -34,8 +40,7 @@ struct Slot {
 static_assert(std::atomic<int>::is_always_lock_free);
 Slot liveTemporaries[AtomicFile::kMaxLive];
 
-constexpr int kHandledSignals[] = {SIGINT, SIGTERM, SIGHUP,
-                                   SIGXFSZ};  // SIGXFSZ: past the file-size limit (ulimit -f)
+const auto& kHandledSignals = AtomicFile::kEndingSignals;
 
 extern "C" void removeTemporariesAndExit(int signal) {
   for (Slot& slot : liveTemporaries)
@@ -43,11 +48,52 @@ extern "C" void removeTemporariesAndExit(int signal) {
   ::_exit(128 + signal);
 }
 
+// Each signal's handler, unless it is ignored: an ignore set by whoever started the program
+// (nohup, a shell's trap '') is a request to keep running.
 void installHandler() {
   static std::once_flag once;
   std::call_once(once, [] {
-    for (const int s : kHandledSignals) std::signal(s, removeTemporariesAndExit);
+    struct sigaction action {};
+    action.sa_handler = removeTemporariesAndExit;
+    sigemptyset(&action.sa_mask);
+    for (const int s : kHandledSignals) sigaddset(&action.sa_mask, s);  // one handler at a time
+    for (const int s : kHandledSignals) {
+      struct sigaction current {};
+      if (::sigaction(s, nullptr, &current) == 0 && current.sa_handler == SIG_IGN) continue;
+      ::sigaction(s, &action, nullptr);
+    }
   });
+}
+
+// The PID in a temporary's name "NAME.tmp-PID-XXXXXX" after `prefix` ("NAME.tmp-"), or 0.
+pid_t temporaryOwner(const std::string& name, const std::string& prefix) {
+  if (name.size() <= prefix.size() + 7 || name.compare(0, prefix.size(), prefix) != 0) return 0;
+  const std::string rest = name.substr(prefix.size());
+  const std::size_t dash = rest.find('-');
+  if (dash == 0 || dash == std::string::npos || rest.size() != dash + 7) return 0;
+  pid_t pid = 0;
+  for (std::size_t i = 0; i < dash; ++i) {
+    if (rest[i] < '0' || rest[i] > '9' || pid > 1'000'000'000) return 0;
+    pid = pid * 10 + (rest[i] - '0');
+  }
+  return pid;
+}
+
+// Removes the temporaries of `path` whose process is gone: left by a run killed by SIGKILL, or
+// one that crashed. A process in another PID namespace or on another host that shares the
+// directory is not seen; its temporary would be taken for stale — not a case this tool meets.
+void removeStaleTemporaries(const std::string& path) {
+  const std::filesystem::path target(path);
+  const std::string prefix = target.filename().string() + ".tmp-";
+  std::error_code error;
+  const std::filesystem::path dir =
+      target.has_parent_path() ? target.parent_path() : std::filesystem::path(".");
+  for (std::filesystem::directory_iterator it(dir, error), end; !error && it != end;
+       it.increment(error)) {
+    const pid_t owner = temporaryOwner(it->path().filename().string(), prefix);
+    if (owner > 0 && owner != ::getpid() && ::kill(owner, 0) != 0 && errno == ESRCH)
+      ::unlink(it->path().c_str());
+  }
 }
 
 // The slot now holding `path`, or -1 when it cannot be held (then the caller gives up).
@@ -89,6 +135,29 @@ class SignalsHeld {
 
 }  // namespace
 
+bool sameFile(const std::string& a, const std::string& b) {
+  struct stat sa {
+  }, sb{};
+  if (::stat(a.c_str(), &sa) == 0 && ::stat(b.c_str(), &sb) == 0)
+    return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+  const auto resolved = [](const std::string& path) {
+    // Absolute first: weakly_canonical leaves a relative path with no existing part relative.
+    std::error_code error;
+    const std::filesystem::path absolute = std::filesystem::absolute(path, error);
+    std::filesystem::path p = std::filesystem::weakly_canonical(absolute, error);
+    return error ? absolute.lexically_normal() : p.lexically_normal();
+  };
+  return resolved(a) == resolved(b);
+}
+
+void refuseInputAsOutput(const std::string& flag, const std::string& path,
+                         const std::vector<InputFile>& inputs) {
+  for (const InputFile& input : inputs)
+    if (!path.empty() && !input.path.empty() && sameFile(path, input.path))
+      throw UsageError(flag + " = " + path + ": the same file as " + input.flag + " = " +
+                       input.path + ", which writing would destroy; expected another path");
+}
+
 AtomicFile::AtomicFile(std::string path, const std::string& flag) : path_(std::move(path)) {
   if (path_.empty()) throw UsageError(flag + " is empty: expected a file path");
   mode_t mode = 0;
@@ -106,12 +175,22 @@ AtomicFile::AtomicFile(std::string path, const std::string& flag) : path_(std::m
     }
     mode = existing.st_mode & 07777;
   } else {
+    struct stat link {};
+    if (::lstat(path_.c_str(), &link) == 0 && S_ISLNK(link.st_mode)) {
+      std::error_code error;
+      const std::string target = std::filesystem::read_symlink(path_, error).string();
+      throw UsageError(flag + " = " + path_ + ": a symbolic link to " +
+                       (error ? "an unreadable target" : target) +
+                       ", which does not exist; expected a new path, an existing file or a link "
+                       "to one");
+    }
     // mkstemp makes the file 0600; a new output gets the usual 0666 less the umask.
     const mode_t mask = ::umask(0);
     ::umask(mask);
     mode = 0666 & ~mask;
   }
-  std::string pattern = path_ + ".tmp-XXXXXX";
+  removeStaleTemporaries(path_);
+  std::string pattern = path_ + ".tmp-" + std::to_string(::getpid()) + "-XXXXXX";
   std::vector<char> name(pattern.begin(), pattern.end());
   name.push_back('\0');
   // The signal handler must know the temporary from the moment it exists: hold the signals

@@ -4,20 +4,43 @@
 #include <cstdio>
 #include <initializer_list>
 #include <string>
+#include <vector>
 
 namespace hamiltone::cli {
+
+// Whether two paths name one file: the same device and inode when both exist (hard links,
+// symlinks, "./a" and "a" alike), else the same path once '.', '..' and the symlinks of its
+// existing part are resolved (what AtomicFile would rename onto).
+bool sameFile(const std::string& a, const std::string& b);
+
+// A file the program reads, by the flag that named it.
+struct InputFile {
+  std::string flag, path;
+};
+
+// Throws UsageError when the output `path` (given by `flag`) is one of the inputs, which writing
+// it would destroy; the message names both flags and paths.
+void refuseInputAsOutput(const std::string& flag, const std::string& path,
+                         const std::vector<InputFile>& inputs);
 
 class AtomicFile {
  public:
   // Creates the temporary now, so an unwritable path fails before any work is done. Throws
-  // UsageError naming `flag` and the path. SIGINT, SIGTERM, SIGHUP and SIGXFSZ remove every live
-  // temporary (up to kMaxLive at once; one more is a std::runtime_error) and exit 128 + N.
+  // UsageError naming `flag` and the path (also for a symlink to nothing: neither followed, as
+  // it would create a file elsewhere, nor replaced, as the link may be meant).
+  //
+  // Every signal whose default would end the program (kEndingSignals) removes every live
+  // temporary (up to kMaxLive at once; one more is a std::runtime_error) and exits 128 + N —
+  // except a signal the program inherited as ignored (nohup's SIGHUP), which stays ignored.
+  // The temporary is named PATH.tmp-PID-XXXXXX: one left by a run that could not clean up
+  // (SIGKILL, a crash) is removed when a later run writes PATH and that PID is gone.
   AtomicFile(std::string path, const std::string& flag);
   ~AtomicFile();  // removes the temporary unless published
   AtomicFile(const AtomicFile&) = delete;
   AtomicFile& operator=(const AtomicFile&) = delete;
 
   static constexpr int kMaxLive = 16;
+  static const int kEndingSignals[12];
 
   std::FILE* stream() { return file_; }
   // Flushes and closes the temporary, keeping it; throws std::runtime_error on an I/O error (a

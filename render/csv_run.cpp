@@ -5,11 +5,18 @@
 
 namespace hamiltone::cli {
 
-long stepCount(double duration, double k, const std::string& ratio) {
+long stepCount(double duration, double k, const std::string& durationFlag,
+               const std::string& stepFlag) {
   const double steps = std::floor(duration / k * (1.0 + 1e-12));
-  if (!(steps >= 1.0) || steps > kMaxSteps)
-    throw UsageError(ratio + " = " + std::to_string(duration / k) +
-                     " steps: expected between 1 and 1e10");
+  if (!(steps >= 1.0))
+    throw UsageError(stepFlag + " = " + formatNumber(k) + " s: longer than " + durationFlag +
+                     " = " + formatNumber(duration) + " s; expected a step at most " +
+                     durationFlag);
+  if (steps > kMaxSteps)
+    throw UsageError(durationFlag + " / " + stepFlag + " = " + formatApprox(duration / k) +
+                     " steps (" + durationFlag + " = " + formatNumber(duration) + " s, " +
+                     stepFlag + " = " + formatNumber(k) + " s): expected at most 1e10; shorten " +
+                     durationFlag + " or raise " + stepFlag);
   return static_cast<long>(steps);
 }
 
@@ -19,6 +26,33 @@ void checkOutputSize(long steps, long every, long columns, const std::string& re
     throw UsageError("the CSV would hold " + std::to_string(static_cast<long long>(numbers)) +
                      " numbers (" + std::to_string(static_cast<long long>(numbers * 2.4e-8)) +
                      " GB): expected at most 2e8; " + remedy);
+}
+
+namespace {
+
+// A time in the unit that reads best: "40 s", "7.5 h", "3.2 years".
+std::string readableSeconds(double s) {
+  if (!std::isfinite(s)) return formatApprox(s) + " s";
+  const struct {
+    double seconds;
+    const char* unit;
+  } units[] = {{365.25 * 86400.0, "years"}, {86400.0, "days"}, {3600.0, "h"}, {60.0, "min"}};
+  for (const auto& u : units)
+    if (s >= u.seconds) return formatApprox(s / u.seconds) + " " + u.unit;
+  return formatApprox(s) + " s";
+}
+
+}  // namespace
+
+void checkWork(double units, const std::string& unitName, double unitsPerSecond, bool allowed,
+               const std::string& remedy) {
+  const double seconds = units / unitsPerSecond;
+  if (allowed || seconds <= kMaxRunSeconds) return;
+  throw UsageError("the run would take about " + readableSeconds(seconds) + " (" +
+                   formatApprox(units) + " " + unitName + " at about " +
+                   formatApprox(unitsPerSecond) + " per second): more than the " +
+                   readableSeconds(kMaxRunSeconds) + " started without --allow-long-run; " +
+                   remedy + ", or give --allow-long-run");
 }
 
 void printSummary(const std::string& command, const std::string& what, const std::string& path,

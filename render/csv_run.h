@@ -11,6 +11,7 @@
 
 #include "schemes/hamiltonian.h"
 #include "usage_error.h"
+#include "util/format_number.h"
 
 namespace hamiltone::cli {
 
@@ -41,7 +42,7 @@ RunSummary runToCsv(Scheme& scheme, long steps, long every, std::FILE* out, Colu
   summary.steps = steps;
   summary.initialEnergy = scheme.energy().total();
   if (!std::isfinite(summary.initialEnergy))
-    throw UsageError("the start's energy is " + std::to_string(summary.initialEnergy) + ": " +
+    throw UsageError("the start's energy is " + formatApprox(summary.initialEnergy) + ": " +
                      tooLarge + " too large for double precision");
   for (long n = 0;; ++n) {
     const Energy e = scheme.energy();
@@ -83,12 +84,25 @@ auto building(Make make) {
 // The most steps a run may take (of its finest step, where it has several).
 inline constexpr double kMaxSteps = 1e10;
 
-// floor(duration / k) steps, refused outside 1 … 1e10; `ratio` names the flags of duration / k.
-long stepCount(double duration, double k, const std::string& ratio = "--duration / --k");
+// floor(duration / k) steps, refused outside 1 … 1e10 naming the flag at fault: the step, when
+// it is longer than the duration; both, when there would be too many.
+long stepCount(double duration, double k, const std::string& durationFlag = "--duration",
+               const std::string& stepFlag = "--k");
 
 // Refuses a CSV of more than 2e8 numbers (a few GB); `remedy` says which flags to change.
 void checkOutputSize(long steps, long every, long columns,
                      const std::string& remedy = "raise --every or shorten --duration");
+
+// The longest run, in estimated seconds, hamiltone-sim starts without --allow-long-run.
+inline constexpr double kMaxRunSeconds = 3600.0;
+
+// Refuses (UsageError) a run whose estimated time exceeds kMaxRunSeconds, unless `allowed`
+// (--allow-long-run): `units` of work — steps × unknowns × quadrature nodes, named `unitName` —
+// at `unitsPerSecond`, a rate measured on one core of a 2-core CI machine (a faster machine
+// takes less; the estimate is for deciding, not a promise). The message prints the estimate and
+// `remedy`.
+void checkWork(double units, const std::string& unitName, double unitsPerSecond, bool allowed,
+               const std::string& remedy);
 
 // The lines a run prints on stdout (and its divergence warning on stderr).
 void printSummary(const std::string& command, const std::string& what, const std::string& path,

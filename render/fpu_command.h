@@ -14,7 +14,7 @@ struct FpuArguments {
   std::string epsilon = "0", sigma0 = "0", every = "1";
   std::string out;
   // --slow-fast: the chain of [M §4.3.1] on the asynchronous scheme (or --sync: synchronous).
-  bool slowFast = false, sync = false;
+  bool slowFast = false, sync = false, allowLongRun = false;
   std::string hs = "1e-2", hf = "2e-4";
   // Set by addFpuCommand: its options' counts tell which flags were given (whatever the text).
   const CLI::App* command = nullptr;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <functional>
+#include <string>
 #include <vector>
 
 #include "midi/midi_message.h"
@@ -18,6 +19,11 @@ struct RenderStats {
   long nonFinite = 0;        // samples the master replaced
   float peak = 0.0f;         // largest |sample| written
 };
+
+// What an unstable render did and why it is refused: per instrument (by its preset file), the
+// notes whose voices the guard silenced, the guard's bound and the scheme's parameters that set
+// the step and grid — the ones to change — and the non-finite samples the master zeroed.
+std::string instabilityReport(const Synth& synth, const RenderStats& stats);
 
 // Renders `seconds` of audio: messages (sorted by time) applied at round(t · rate), in blocks of
 // `block` frames. `progress` is called after each block with the seconds rendered so far.

@@ -112,6 +112,9 @@ int runPlateCommand(const PlateArguments& a) {
   physics.young = parseReal("--young", a.young, Range::positive, "Pa");
   physics.density = parseReal("--density", a.density, Range::positive, "kg/m^3");
   physics.poisson = parseReal("--poisson", a.poisson, Range::any);
+  if (!(physics.poisson > -1.0 && physics.poisson < 0.5))
+    throw UsageError("--poisson = " + a.poisson +
+                     ": out of range; expected a ratio between -1 and 0.5 (an isotropic solid)");
   physics.thickness = parseReal("--thickness", a.thickness, Range::positive, "m");
   physics.lx = parseReal("--lx", a.lx, Range::positive, "m");
   physics.ly = parseReal("--ly", a.ly, Range::positive, "m");

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "atomic_file.h"
 #include "midi/midi_file.h"
 #include "note_list.h"
 #include "number_arguments.h"
@@ -45,6 +46,10 @@ int run(const RenderArguments& a) {
   if (a.midi.empty() == a.notes.empty())
     throw UsageError("give exactly one of --midi FILE or --notes LIST");
   if (a.out.empty()) throw UsageError("-o FILE: the WAV file to write is required");
+  std::vector<InputFile> inputs{{"--midi", a.midi}};
+  for (const std::string& file : a.presets) inputs.push_back({"--preset", file});
+  if (a.presets.empty()) inputs.push_back({"--preset (the default)", HAMILTONE_DEFAULT_PRESET});
+  refuseInputAsOutput("-o", a.out, inputs);
   const double rate =
       static_cast<double>(parseInteger("--sample-rate", a.sampleRate, 8000, 384000));
   const double tail = parseReal("--tail", a.tail, Range::nonNegative, " seconds");
@@ -110,16 +115,14 @@ int run(const RenderArguments& a) {
   const RenderStats stats = renderPerformance(synth, messages, seconds, block, rate, out,
                                               [&](double done) { bar.update(done); });
   bar.finish();
+  // An output the program knows is wrong is not written: the temporary goes with `out`.
+  if (stats.guardEvents > 0 || stats.nonFinite > 0)
+    throw UsageError(instabilityReport(synth, stats));
   out.commit();
   if (!a.quiet) {
     std::fprintf(stderr, "hamiltone-render: %s: %s\n", a.out.c_str(),
                  renderSummary(stats.seconds, stats.wallSeconds).c_str());
   }
-  if (stats.guardEvents > 0 || stats.nonFinite > 0)
-    std::fprintf(stderr,
-                 "hamiltone-render: warning: the guard silenced %d voice(s) and %ld non-finite "
-                 "sample(s) were zeroed: the preset is unstable for these notes\n",
-                 stats.guardEvents, stats.nonFinite);
   return 0;
 }
 
@@ -143,7 +146,8 @@ int main(int argc, char** argv) {
                  "\"C3:100:2.0, E3@0.5:90:1.5\" (C4 = MIDI 60; START 0, VELOCITY 100 and "
                  "DURATION 1 s by default)")
       ->type_name("LIST");
-  app.add_option("-o,--out", a.out, "WAV file to write (replaced whole, or untouched on error)")
+  app.add_option("-o,--out", a.out,
+                 "WAV file to write (replaced whole, or untouched on error); not an input file")
       ->type_name("FILE");
   addNumberOption(&app, "--sample-rate", a.sampleRate, "HZ", "sample rate, 8000 … 384000");
   app.add_option("--format", a.format, "sample format")
@@ -157,7 +161,9 @@ int main(int argc, char** argv) {
                "print every preset parameter (name, type, unit, range, default) and exit");
   app.footer(
       "Exit codes: 0 done, 1 an I/O error (no file is left), 2 bad input (arguments, preset or "
-      "MIDI file; no file is written), 128+N killed by signal N (no file left).");
+      "MIDI file, or a preset found unstable for the notes played; no file is written), 128+N "
+      "ended by signal N (no file left; a signal ignored when it starts, as under nohup, stays "
+      "ignored).");
 
   try {
     app.parse(argc, argv);

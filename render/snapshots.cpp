@@ -1,39 +1,15 @@
 // The snapshot times and the snapshot writer of the string and plate subcommands.
 #include "snapshots.h"
 
-#include <sys/stat.h>
-
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
-#include <system_error>
 
+#include "atomic_file.h"
 #include "number_arguments.h"
 #include "usage_error.h"
+#include "util/format_number.h"
 
 namespace hamiltone::cli {
-
-namespace {
-
-// Whether two paths name one file: the same device and inode when both exist (hard links,
-// symlinks, "./a" and "a" alike), else the same path once '.', '..' and the symlinks of its
-// existing part are resolved (what AtomicFile would rename onto).
-bool sameFile(const std::string& a, const std::string& b) {
-  struct stat sa {
-  }, sb{};
-  if (::stat(a.c_str(), &sa) == 0 && ::stat(b.c_str(), &sb) == 0)
-    return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
-  const auto resolved = [](const std::string& path) {
-    // Absolute first: weakly_canonical leaves a relative path with no existing part relative.
-    std::error_code error;
-    const std::filesystem::path absolute = std::filesystem::absolute(path, error);
-    std::filesystem::path p = std::filesystem::weakly_canonical(absolute, error);
-    return error ? absolute.lexically_normal() : p.lexically_normal();
-  };
-  return resolved(a) == resolved(b);
-}
-
-}  // namespace
 
 void checkSnapshotFlags(const std::string& times, const std::string& file, const std::string& out) {
   if (times.empty() != file.empty())
@@ -60,7 +36,7 @@ std::vector<long> snapshotSteps(const std::string& times, double k, long steps) 
     const long n = static_cast<long>(std::ceil(t / k * (1.0 - 1e-12)));
     if (n > steps)
       throw UsageError("--snapshots = " + item + ": after the last step (t = " +
-                       std::to_string(static_cast<double>(steps) * k) +
+                       formatApprox(static_cast<double>(steps) * k) +
                        " s); expected times <= --duration");
     result.push_back(n);
     if (comma == std::string::npos) break;

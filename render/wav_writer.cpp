@@ -1,7 +1,9 @@
 // libsndfile writes through the descriptor of an AtomicFile's temporary (sf_open_fd, which
 // leaves the descriptor to AtomicFile), so AtomicFile alone decides whether the file appears:
-// commit() renames it, the destructor and SIGINT/SIGTERM/SIGHUP remove it.
+// commit() renames it, the destructor and the signals that end the program remove it.
 #include "wav_writer.h"
+
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -63,6 +65,11 @@ WavWriter::WavWriter(std::string path, const std::string& flag, int sampleRate, 
   // step past the largest code — instead of wrapping it to -1. (It then rounds down, 1.2.0
   // measured: an error below one step, where without clipping it rounds to nearest.)
   if (format != SampleFormat::float32) sf_command(sound_, SFC_SET_CLIPPING, nullptr, SF_TRUE);
+  // A float file would get a PEAK chunk stamped with the time of writing, so two renders of the
+  // same input would differ in those bytes. The peaks are known to be within ±1 (sanitised), so
+  // the chunk says nothing worth a non-reproducible file. Must precede the first write.
+  if (format == SampleFormat::float32)
+    sf_command(sound_, SFC_SET_ADD_PEAK_CHUNK, nullptr, SF_FALSE);
   chunk_.resize(kChunkFrames * static_cast<std::size_t>(channels_));
 }
 
@@ -76,9 +83,13 @@ void WavWriter::write(const float* interleaved, std::size_t frames) {
     const std::size_t n = std::min(frames, kChunkFrames);
     const std::size_t samples = n * static_cast<std::size_t>(channels_);
     std::transform(interleaved, interleaved + samples, chunk_.begin(), sanitised);
-    if (sf_writef_float(sound_, chunk_.data(), static_cast<sf_count_t>(n)) !=
-        static_cast<sf_count_t>(n))
+    const sf_count_t done = sf_writef_float(sound_, chunk_.data(), static_cast<sf_count_t>(n));
+    if (done != static_cast<sf_count_t>(n)) {
+      written_ += static_cast<std::size_t>(std::max<sf_count_t>(done, 0));
+      failed_ = true;
       throw std::runtime_error("writing " + path_ + " failed: " + sf_strerror(sound_));
+    }
+    written_ += n;
     interleaved += samples;
     frames -= n;
   }
@@ -86,6 +97,18 @@ void WavWriter::write(const float* interleaved, std::size_t frames) {
 
 void WavWriter::commit() {
   if (!sound_) throw std::logic_error("WavWriter::commit twice: " + path_);
+  if (failed_) {
+    // Cut what a failed write left past the last whole frame: seeking the write position to
+    // that frame puts the descriptor at the end of the data that is kept. libsndfile computes
+    // the header's sizes from the file's length on close.
+    const int fd = fileno(file_.stream());
+    const off_t end = sf_seek(sound_, static_cast<sf_count_t>(written_), SEEK_SET) < 0
+                          ? -1
+                          : ::lseek(fd, 0, SEEK_CUR);
+    if (end < 0 || ::ftruncate(fd, end) != 0)
+      throw std::runtime_error("writing " + path_ + " failed: cannot cut it to the " +
+                               std::to_string(written_) + " frames written");
+  }
   const int error = sf_close(sound_);  // writes the final header
   sound_ = nullptr;
   if (error != SF_ERR_NO_ERROR)

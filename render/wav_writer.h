@@ -1,4 +1,5 @@
-// A WAV file written through libsndfile that appears whole on commit() or not at all.
+// A WAV file written through libsndfile that appears whole on commit() or not at all, and is the
+// same bytes for the same samples (no time stamp in any chunk).
 #pragma once
 
 #include <sndfile.h>
@@ -29,10 +30,15 @@ class WavWriter {
   // the rest is clamped to [-1, 1] — so one bad sample cannot wrap around in PCM or put a NaN
   // or a value past full scale in a float file. Copies through a buffer sized once in the
   // constructor, so a call allocates nothing.
-  // Throws std::runtime_error naming the path and libsndfile's message (a full disk).
+  // Throws std::runtime_error naming the path and libsndfile's message (a full disk); the frames
+  // written before the failure are kept, and framesWritten() counts them.
   void write(const float* interleaved, std::size_t frames);
   // Writes the header, closes and renames onto the path; throws std::runtime_error on an error.
+  // After a failed write() the file is cut to framesWritten() whole frames first, so what
+  // appears is a valid WAV of what was written before the failure.
   void commit();
+
+  std::size_t framesWritten() const { return written_; }
 
   const std::string& path() const { return path_; }
   int sampleRate() const { return sampleRate_; }
@@ -44,6 +50,8 @@ class WavWriter {
   AtomicFile file_;
   SNDFILE* sound_ = nullptr;  // writes through the temporary's descriptor
   std::vector<float> chunk_;  // sanitised samples on their way to libsndfile
+  std::size_t written_ = 0;   // whole frames libsndfile took
+  bool failed_ = false;       // a write() failed: the file may end in part of a frame
 };
 
 }  // namespace hamiltone::cli

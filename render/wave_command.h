@@ -12,7 +12,7 @@ struct WaveArguments {
   std::string quadrature = "midpoint";
   std::string alpha = "0.99", amplitude = "0.3", dx = "0.01";
   std::string k = "0.0033", duration = "1", every = "1";
-  bool adaptive = false;
+  bool adaptive = false, allowLongRun = false;
   std::string epsFly = "3e-4", minStep;            // minStep not given: k / 1024
   bool epsFlyGiven = false, minStepGiven = false;  // typed on the command line (need --adaptive)
   std::string snapshots, snapshotOut;

@@ -110,7 +110,7 @@ int runWaveInhomogeneousCommand(const WaveInhomogeneousArguments& a) {
   // Output and memory before the model is built: N + 1 rows of 3 numbers, N − 1 particles.
   const double intervals = std::round(1.0 / dx);
   if (!(intervals <= kMaxIntervals))
-    throw UsageError("--dx = " + a.dx + ": 1/dx = " + formatNumber(1.0 / dx) +
+    throw UsageError("--dx = " + a.dx + ": 1/dx = " + formatApprox(1.0 / dx) +
                      " intervals, expected at most 1e7 (memory and CSV size); use --dx >= 1e-7");
   checkOutputSize(static_cast<long>(intervals), 1, 3, "raise --dx");
   const InhomogeneousWave wave = building([&] {
@@ -125,7 +125,7 @@ int runWaveInhomogeneousCommand(const WaveInhomogeneousArguments& a) {
     throw UsageError("--ratio = " + a.ratio + ": h_F = Δx/K = " + formatNumber(hf) +
                      " s breaks the CFL bound (16) of the fast part, h_F <= Δx/c₁ = " +
                      formatNumber(wave.fastStepBound()) + " s; use --ratio >= 10");
-  const long coarseSteps = stepCount(duration, hs, "--duration / --dx (h_S = Δx)");
+  const long coarseSteps = stepCount(duration, hs, "--duration", "--dx (h_S = Δx)");
   const double fineSteps = static_cast<double>(coarseSteps) * static_cast<double>(ratio);
   if (fineSteps > kMaxSteps)
     throw UsageError("--duration / --dx × --ratio = " + formatNumber(fineSteps) +

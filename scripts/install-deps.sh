@@ -9,7 +9,10 @@ packages=(
   libcli11-dev        # render/: hamiltone-sim's and hamiltone-render's command lines
   libtomlplusplus-dev # engine/presets: the TOML preset files
   libsndfile1-dev     # render/: hamiltone-render's WAV output
-  librtaudio-dev librtmidi-dev  # app/: hamiltone-play's audio output and MIDI input
+  # app/: hamiltone-play's audio output and MIDI input. They need a JACK development package,
+  # "libjack-dev | libjack-jackd2-dev": named, or apt takes the first, jackd1's, which removes
+  # jackd2 (below) — and the next run's jackd2 removes these two.
+  libjack-jackd2-dev librtaudio-dev librtmidi-dev
   libgtest-dev libgmock-dev  # tests/
   clang libclang-rt-14-dev   # tests/fuzz: libFuzzer targets for the MIDI reader and preset loader
   clang-22 libclang-rt-22-dev llvm-22  # tests/rtsan: RTSan test (bookworm-security; llvm-22 symbolises)
@@ -18,10 +21,22 @@ packages=(
   python3-matplotlib python3-numpy  # scripts/validation.sh: the figures of docs/validation.md (Debian's, run by /usr/bin/python3)
 )
 
+# --list: the packages, one a line; --missing: those not installed, as dpkg's database in
+# $INSTALL_DEPS_ADMINDIR (default /var/lib/dpkg) has them. Both for scripts/check-install-deps.sh.
+if [ "${1:-}" = "--list" ]; then
+  printf '%s\n' "${packages[@]}"
+  exit 0
+fi
+
 missing=()
 for p in "${packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")
+  dpkg-query --admindir="${INSTALL_DEPS_ADMINDIR:-/var/lib/dpkg}" -W -f='${Status}' "$p" \
+    2>/dev/null | grep -q 'install ok installed' || missing+=("$p")
 done
+if [ "${1:-}" = "--missing" ]; then
+  [ ${#missing[@]} -eq 0 ] || printf '%s\n' "${missing[@]}"
+  exit 0
+fi
 [ ${#missing[@]} -eq 0 ] && exit 0
 
 if [ "$(id -u)" -eq 0 ]; then

@@ -13,14 +13,20 @@ namespace hamiltone {
 // length's parameter) and `rule` (where h came from).
 inline int segmentsAlong(double length, double h, double k, double maximum, const std::string& what,
                          const std::string& rule) {
+  if (!(h > 0.0) || !std::isfinite(h))
+    throw std::invalid_argument(
+        what + " = " + formatNumber(length) + " m: the grid spacing h (" + rule +
+        ") at k = " + formatApprox(k) + " s is " + formatApprox(h) +
+        ": a material parameter or the step is beyond what double precision holds; expected "
+        "values of physical size");
   const double segments = std::floor(length / h);
   if (!(segments >= 2.0))
     throw std::invalid_argument(
         what + " = " + formatNumber(length) + " m: shorter than two grid spacings h = " +
-        formatNumber(h) + " m at k = " + formatNumber(k) + " s (" + rule +
+        formatApprox(h) + " m at k = " + formatApprox(k) + " s (" + rule +
         "); use a smaller time step (oversampling) or a smaller grid factor");
   if (segments > maximum)
-    throw std::invalid_argument("the grid would have " + formatNumber(segments) +
+    throw std::invalid_argument("the grid would have " + formatApprox(segments) +
                                 " segments along " + what + "; expected at most " +
                                 formatNumber(maximum) + " (use a larger time step)");
   return static_cast<int>(segments);

@@ -58,7 +58,7 @@ NonlinearString::NonlinearString(const StringPhysics& p, StringGrid grid)
                                 ": must be a finite number >= 0 (m^4)");
   if (p.young * p.area <= p.tension)
     throw std::invalid_argument("tension = " + formatNumber(p.tension) +
-                                " N: must be below E*A = " + formatNumber(p.young * p.area) +
+                                " N: must be below E*A = " + formatApprox(p.young * p.area) +
                                 " N, or the split potential (65) is not >= 0");
   if (grid.transverse < 2)
     throw std::invalid_argument("segments = " + std::to_string(grid.transverse) + ": must be >= 2");

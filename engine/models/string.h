@@ -102,6 +102,13 @@ enum class GridRule {
   twoGrid,       // u on the transverse grid, v on a coarse nested one with h_v >= sqrt(E/ρ) k
 };
 
+// As a preset writes it (scheme.grid_rule): "two-grid", "transverse", "longitudinal".
+constexpr const char* gridRuleName(GridRule rule) {
+  return rule == GridRule::twoGrid      ? "two-grid"
+         : rule == GridRule::transverse ? "transverse"
+                                        : "longitudinal";
+}
+
 // The smallest h the rule allows (u's for twoGrid): transverse h² = (c²k² + 4σ1k + sqrt((c²k² + 4σ1k)² + 16κ²k²))/2
 // with c² = T0/ρA, κ² = EI/ρA (the continuous form of maxStableStep, so slightly conservative);
 // longitudinal h = max(sqrt(E/ρ) k, the transverse h).

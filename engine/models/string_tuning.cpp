@@ -39,8 +39,8 @@ double solve(const StringPhysics& p, TuneBy by, int segments, double k, double t
     throw std::invalid_argument(std::string(by == TuneBy::tension ? "tension" : "length") +
                                 ": no value puts the fundamental on " + formatNumber(target) +
                                 " Hz with " + std::to_string(segments) +
-                                " segments at k = " + formatNumber(k) + " s (the tension " +
-                                "must stay below E*A = " + formatNumber(p.young * p.area) + " N)");
+                                " segments at k = " + formatApprox(k) + " s (the tension " +
+                                "must stay below E*A = " + formatApprox(p.young * p.area) + " N)");
   for (int i = 0; i < 200 && hi / lo - 1.0 > 1e-15; ++i) {
     const double mid = std::sqrt(lo * hi);
     (below(mid) ? lo : hi) = mid;
@@ -55,7 +55,7 @@ TunedString tuneString(const StringPhysics& guess, TuneBy by, GridRule rule, dou
   if (!std::isfinite(targetHz) || targetHz <= 0.0 || targetHz >= 0.5 / k)
     throw std::invalid_argument("target pitch = " + formatNumber(targetHz) +
                                 " Hz: must be between 0 and the Nyquist frequency " +
-                                formatNumber(0.5 / k) + " Hz");
+                                formatApprox(0.5 / k) + " Hz");
   auto grids = [&](const StringPhysics& p) {
     return stringGrid(p, rule, k, sigma1, gridFactor, tensionMargin);
   };

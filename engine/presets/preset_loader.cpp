@@ -95,7 +95,7 @@ std::string show(const toml::node& v) {
 }
 
 // A value computed for a key rather than written: six significant digits.
-std::string approximate(double x) { return formatSignificant(x, 6); }
+std::string approximate(double x) { return formatApprox(x, 6); }
 
 std::string_view modelName(InstrumentModel m) {
   return m == InstrumentModel::string ? "string" : "plate";

@@ -31,7 +31,7 @@ inline void checkStepParameters(const StepParameters& p, bool hasEpsilon) {
   if (p.sigma0 * p.k >= 1.0)
     throw std::invalid_argument("loss sigma0 = " + formatNumber(p.sigma0) +
                                 " with k = " + formatNumber(p.k) +
-                                ": sigma0*k must be < 1, i.e. sigma0 < " + formatNumber(1.0 / p.k));
+                                ": sigma0*k must be < 1, i.e. sigma0 < " + formatApprox(1.0 / p.k));
   if (!std::isfinite(p.sigma1) || p.sigma1 < 0.0)
     throw std::invalid_argument("loss sigma1 = " + formatNumber(p.sigma1) +
                                 ": must be a finite number >= 0 (m^2/s)");

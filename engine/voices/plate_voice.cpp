@@ -165,6 +165,17 @@ void PlateVoice::noteOn(double velocity) noexcept {
   scheme_->setSigma0(loss_.sigma0);
 }
 
+// The raised cosine F(t) = F0 (1 − cos(2πt/T)) / 2 on [0, T], averaged over the step's window
+// [t − k/2, t + k/2]: F(t) to O(k²) for a pulse of many steps, and for one shorter than a step
+// its whole impulse F0 T / 2 — sampled at t = 0, k, …, such a pulse gave F(0) = 0, silence.
+// The windows tile the time axis, so the impulse delivered is F0 T / 2 at every k.
+double PlateVoice::pulseOverStep() const noexcept {
+  const double w = 2.0 * std::numbers::pi / pulseDuration_;
+  const double a = std::clamp(pulseTime_ - 0.5 * k_, 0.0, pulseDuration_);
+  const double b = std::clamp(pulseTime_ + 0.5 * k_, 0.0, pulseDuration_);
+  return pulseForce_ * 0.5 * ((b - a) - (std::sin(w * b) - std::sin(w * a)) / w) / k_;
+}
+
 void PlateVoice::release() noexcept {
   released_ = true;
   scheme_->setSigma0(loss_.sigma0 + kLn1000 / patch_.damperT60);
@@ -198,10 +209,9 @@ void PlateVoice::process(std::span<float> left, std::span<float> right) noexcept
     double out[2] = {0.0, 0.0};
     bool ready = false;
     while (!ready) {
-      if (pulsing_) {  // raised cosine in time: F(t) = F0 (1 − cos(2πt/T)) / 2
-        if (pulseTime_ < pulseDuration_) {
-          const double f = pulseForce_ * 0.5 *
-                           (1.0 - std::cos(2.0 * std::numbers::pi * pulseTime_ / pulseDuration_));
+      if (pulsing_) {
+        if (pulseTime_ - 0.5 * k_ < pulseDuration_) {
+          const double f = pulseOverStep();
           for (size_t s = 0; s < strikeIndex_.size(); ++s)
             scheme_->setForce(strikeIndex_[s], f * strikeWeight_[s]);
           pulseTime_ += k_;

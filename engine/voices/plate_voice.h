@@ -75,6 +75,8 @@ class PlateVoice {
   std::vector<double> strikeWeight_;
   PlateLoss loss_;
   double sampleRate_ = 0.0, k_ = 0.0, lowestMode_ = 0.0;
+  double pulseOverStep() const noexcept;
+
   double pulseTime_ = 0.0, pulseDuration_ = 0.0, pulseForce_ = 0.0;
   int guardEvents_ = 0;
   bool active_ = false, released_ = false, pulsing_ = false;

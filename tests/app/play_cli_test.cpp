@@ -1,34 +1,50 @@
-// hamiltone-play's command line where no audio device is needed: presets and every --set are read
-// before any device is opened, so a bad --set is refused (exit 2, one message naming it) and a
-// good one gets as far as the audio API — here a JACK server that does not exist.
+// hamiltone-play's command line where no audio device is needed: presets, every --set and the
+// --record target are checked before any device is opened, so a bad one is refused (exit 2, one
+// message naming it, files left as they were) and a good one gets as far as the audio API — here
+// a JACK server that does not exist.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <utility>
 
+#include "support/riff_chunks.h"
 #include "support/run_command.h"
 
 namespace {
 
+namespace fs = std::filesystem;
 using hamiltone::testing::CommandResult;
-
-// hamiltone-play --api jack ARGS with a JACK server name of its own that no server has, so a
-// developer's JACK server is never met and none is started.
-CommandResult play(const std::string& args) {
-  const std::string pid = std::to_string(::getpid());
-  return hamiltone::testing::runCommand(
-      "JACK_DEFAULT_SERVER=hamiltone-none-" + pid + " JACK_NO_START_SERVER=1 timeout 60 " +
-          HAMILTONE_PLAY + " --api jack " + args,
-      std::filesystem::temp_directory_path() / ("hamiltone-play-cli-" + pid + ".err"));
-}
 
 std::string preset(const char* name) {
   return std::string(HAMILTONE_SOURCE_DIR) + "/presets/" + name + ".toml";
 }
 
-TEST(PlayCli, RefusesABadSetBeforeOpeningAnyDevice) {
+class PlayCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string pattern = (fs::temp_directory_path() / "hamiltone-play-cli-XXXXXX").string();
+    ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
+    dir_ = pattern;
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // hamiltone-play --api jack ARGS with a JACK server name of its own that no server has, so a
+  // developer's JACK server is never met and none is started.
+  CommandResult play(const std::string& args) const {
+    const std::string pid = std::to_string(::getpid());
+    return hamiltone::testing::runCommand("JACK_DEFAULT_SERVER=hamiltone-none-" + pid +
+                                              " JACK_NO_START_SERVER=1 timeout 60 " +
+                                              HAMILTONE_PLAY + " --api jack " + args,
+                                          dir_ / "stderr");
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(PlayCli, RefusesABadSetBeforeOpeningAnyDevice) {
   const std::string c3 = "--preset " + preset("paper-c3-string");
   for (const auto& [args, mention] :
        {std::pair<std::string, std::string>{
@@ -44,12 +60,27 @@ TEST(PlayCli, RefusesABadSetBeforeOpeningAnyDevice) {
 }
 
 // Past the presets: the refusal is the audio API's, not a preset's.
-TEST(PlayCli, AcceptsAGoodSetAndGoesOnToTheAudioDevice) {
+TEST_F(PlayCli, AcceptsAGoodSetAndGoesOnToTheAudioDevice) {
   const CommandResult r = play("--preset " + preset("paper-c3-string") +
                                " --set scheme.grid_rule=longitudinal --set scheme.oversampling=16");
   EXPECT_EQ(r.exitCode, 2) << r.err;
   EXPECT_NE(r.err.find("no audio output device for API jack"), std::string::npos) << r.err;
   EXPECT_EQ(r.err.find("--set"), std::string::npos) << r.err;
+}
+
+// --record naming a preset (directly or through a link) would overwrite it with audio.
+TEST_F(PlayCli, RefusesToRecordOntoAPreset) {
+  const fs::path toml = dir_ / "in.toml", link = dir_ / "take.wav";
+  fs::copy_file(preset("paper-c3-string"), toml);
+  const std::string before = hamiltone::testing::fileBytes(toml);
+  fs::create_symlink(toml, link);
+  for (const fs::path& out : {toml, link}) {
+    const CommandResult r = play("--quiet --preset " + toml.string() + " --record " + out.string());
+    EXPECT_EQ(r.exitCode, 2) << r.err;
+    EXPECT_NE(r.err.find("--record = " + out.string()), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("--preset = " + toml.string()), std::string::npos) << r.err;
+    EXPECT_EQ(hamiltone::testing::fileBytes(toml), before);
+  }
 }
 
 }  // namespace

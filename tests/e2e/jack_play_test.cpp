@@ -37,6 +37,7 @@
 extern char** environ;
 
 #include "support/spectrum.h"
+#include "support/tiny_disk.h"
 
 namespace {
 
@@ -295,30 +296,34 @@ class JackPlay : public ::testing::Test {
 
   fs::path wav() const { return dir_ / "out.wav"; }
 
-  // A server of its own, the player on it, the score from the sender, at least 10 s of audio;
-  // then SIGINT to the player and SIGTERM to the server. Fatal failures for anything that keeps
-  // the run from happening.
-  void perform(bool realtime, int attempt, Performance& run) {
-    stopAll();
-    useServer(name_ + "-" + std::to_string(attempt));
+  // A server of its own (server_) on the dummy driver, answering. Fatal failure otherwise.
+  void startServer(bool realtime) {
     spawn(jackd_,
           {"jackd", "-n", server_, realtime ? "--realtime" : "--no-realtime", "-d", "dummy", "-r",
            "48000", "-p", std::to_string(kPeriod)},
           "jackd");
     ASSERT_TRUE(jackd_->started());
-    Clock::time_point deadline = Clock::now() + 15s;
+    const Clock::time_point deadline = Clock::now() + 15s;
     while (!ports() && Clock::now() < deadline && !jackd_->wait(0.1)) {
     }
     ASSERT_TRUE(ports()) << "the JACK server did not come up:\n" << slurp(dir_ / "jackd.err");
+  }
 
-    spawn(player_,
-          {HAMILTONE_PLAY, "--api", "jack", "--virtual-midi", "hamiltone-in", "--record",
-           wav().string(), "--quiet", "--preset", HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml",
-           "--preset", HAMILTONE_SOURCE_DIR "/presets/paper-c3-string.toml"},
-          "player");
+  // The player on that server, recording to `record`, with `extra` arguments; returns when it is
+  // ready — its MIDI port exists, and the stream starts right after it is made.
+  void startPlayer(const std::vector<std::string>& extra, const fs::path& record = {}) {
+    std::vector<std::string> argv = {HAMILTONE_PLAY,
+                                     "--api",
+                                     "jack",
+                                     "--virtual-midi",
+                                     "hamiltone-in",
+                                     "--record",
+                                     (record.empty() ? wav() : record).string(),
+                                     "--quiet"};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    spawn(player_, argv, "player");
     ASSERT_TRUE(player_->started());
-    // Ready when its MIDI port exists: the stream starts right after it is made.
-    deadline = Clock::now() + 60s;
+    const Clock::time_point deadline = Clock::now() + 60s;
     std::string list;
     while (list.find(":hamiltone-in") == std::string::npos && Clock::now() < deadline &&
            !player_->wait(0.1))
@@ -326,6 +331,18 @@ class JackPlay : public ::testing::Test {
     ASSERT_NE(list.find(":hamiltone-in"), std::string::npos)
         << "the player's MIDI port did not appear:\n"
         << slurp(dir_ / "player.err");
+  }
+
+  // A server of its own, the player on it, the score from the sender, at least 10 s of audio;
+  // then SIGINT to the player and SIGTERM to the server. Fatal failures for anything that keeps
+  // the run from happening.
+  void perform(bool realtime, int attempt, Performance& run) {
+    stopAll();
+    useServer(name_ + "-" + std::to_string(attempt));
+    ASSERT_NO_FATAL_FAILURE(startServer(realtime));
+    ASSERT_NO_FATAL_FAILURE(
+        startPlayer({"--preset", HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml", "--preset",
+                     HAMILTONE_SOURCE_DIR "/presets/paper-c3-string.toml"}));
     const Clock::time_point readyAt = Clock::now();
 
     spawn(sender_, {HAMILTONE_MIDI_SENDER, "hamiltone-in", "10"}, "sender");
@@ -463,6 +480,102 @@ TEST_F(JackPlay, PlaysAScriptedPerformanceOnTimeInTuneAndWithoutUnderruns) {
   ASSERT_LT(overran, kAttempts) << "the player's callback took longer than its period in every run";
   GTEST_SKIP() << "the JACK server logged xruns in all " << kAttempts
                << " runs (a busy host): onset timing and underruns were not judged";
+}
+
+// The files in the test's directory whose name marks a temporary.
+std::vector<std::string> temporaries(const fs::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dir))
+    if (entry.path().filename().string().find(".tmp-") != std::string::npos)
+      names.push_back(entry.path().filename());
+  return names;
+}
+
+// The player ends with `code` within 30 s, its stderr says `why` and that it recorded, and the
+// recording is a valid WAV of at least `frames` frames with no temporary beside it.
+void expectEndedWithTheRecording(std::optional<Child>& player, const fs::path& dir, int code,
+                                 const std::string& why, size_t frames) {
+  EXPECT_EQ(player->wait(30.0), code) << slurp(dir / "player.err");
+  const std::string err = slurp(dir / "player.err");
+  EXPECT_NE(err.find(why), std::string::npos) << err;
+  EXPECT_NE(err.find("recorded "), std::string::npos) << err;
+  SF_INFO info;
+  EXPECT_GE(readMono(dir / "out.wav", info).size(), frames) << "no valid recording";
+  EXPECT_TRUE(temporaries(dir).empty());
+}
+
+// Under nohup (SIGHUP inherited as ignored) a hang-up leaves the player playing; a signal that
+// would end it — here SIGUSR1 — stops it with the recording complete, exit 128 + N, no temporary.
+TEST_F(JackPlay, KeepsAnIgnoredHangupAndCompletesTheRecordingOnOtherSignals) {
+  if (!onPath("jackd") || !onPath("jack_lsp"))
+    GTEST_SKIP() << "jackd (Debian's jackd2) is not installed";
+  ASSERT_NO_FATAL_FAILURE(startServer(false));
+  struct sigaction ignore {
+  }, previous{};
+  ignore.sa_handler = SIG_IGN;
+  ::sigaction(SIGHUP, &ignore, &previous);  // inherited by the player, as under nohup
+  startPlayer({"--preset", HAMILTONE_SOURCE_DIR "/presets/paper-c3-string.toml"});
+  ::sigaction(SIGHUP, &previous, nullptr);
+  ASSERT_FALSE(HasFatalFailure());
+  player_->signal(SIGHUP);
+  EXPECT_FALSE(player_->wait(1.0)) << "a hang-up ended the player:\n" << slurp(dir_ / "player.err");
+  player_->signal(SIGUSR1);
+  expectEndedWithTheRecording(player_, dir_, 128 + SIGUSR1, "stopped by SIGUSR1",
+                              24000);  // 1 s, less start-up
+}
+
+// The JACK server going away mid-performance — stopped (SIGTERM) or killed (SIGKILL): the player
+// notices (JACK shuts its clients down and RtAudio closes the stream), completes the recording up
+// to then, says why and exits 3, instead of running on in silence.
+TEST_F(JackPlay, ALostServerEndsThePlayerWithTheRecordingComplete) {
+  if (!onPath("jackd") || !onPath("jack_lsp"))
+    GTEST_SKIP() << "jackd (Debian's jackd2) is not installed";
+  for (const int signal : {SIGTERM, SIGKILL}) {
+    SCOPED_TRACE(::strsignal(signal));
+    stopAll();
+    useServer(name_ + "-lost-" + std::to_string(signal));
+    ASSERT_NO_FATAL_FAILURE(startServer(false));
+    ASSERT_NO_FATAL_FAILURE(
+        startPlayer({"--preset", HAMILTONE_SOURCE_DIR "/presets/paper-c3-string.toml"}));
+    std::this_thread::sleep_for(500ms);  // something to record
+    jackd_->signal(signal);
+    jackd_->wait(10.0);
+    expectEndedWithTheRecording(player_, dir_, 3, "the audio stream is gone", 1);
+    fs::remove(wav());
+    // A killed server leaves its entry in JACK's registry of servers (at most 8, per machine, all
+    // users): a server of the same name reclaims it, and stopping that one frees it.
+    if (signal == SIGKILL) {
+      ASSERT_NO_FATAL_FAILURE(startServer(false));
+      jackd_->signal(SIGTERM);
+      EXPECT_EQ(jackd_->wait(10.0), 0) << slurp(dir_ / "jackd.err");
+    }
+  }
+}
+
+// Recording onto a disk that fills (a 64 KiB tmpfs: 0.23 s of 24-bit stereo at 48 kHz): the
+// player says the recording stopped, plays on, and on SIGINT keeps the WAV up to the error and
+// exits 1 — where it aborted (exit 134) and left its temporary.
+TEST_F(JackPlay, AFullDiskStopsTheRecordingNotThePlayer) {
+  if (!onPath("jackd") || !onPath("jack_lsp"))
+    GTEST_SKIP() << "jackd (Debian's jackd2) is not installed";
+  const fs::path full = dir_ / "full";
+  hamiltone::test::TinyDisk disk(full);
+  if (!disk.mounted()) GTEST_SKIP() << "cannot mount a 64 KiB tmpfs here (needs root)";
+  ASSERT_NO_FATAL_FAILURE(startServer(false));
+  ASSERT_NO_FATAL_FAILURE(startPlayer(
+      {"--preset", HAMILTONE_SOURCE_DIR "/presets/paper-c3-string.toml"}, full / "take.wav"));
+  for (int i = 0;
+       i < 300 && slurp(dir_ / "player.err").find("recording stopped") == std::string::npos; ++i)
+    std::this_thread::sleep_for(100ms);
+  EXPECT_FALSE(player_->wait(0.5)) << "the player ended:\n" << slurp(dir_ / "player.err");
+  player_->signal(SIGINT);
+  EXPECT_EQ(player_->wait(30.0), 1) << slurp(dir_ / "player.err");
+  const std::string err = slurp(dir_ / "player.err");
+  EXPECT_NE(err.find("recording stopped at"), std::string::npos) << err;
+  EXPECT_NE(err.find("holds the"), std::string::npos) << err;
+  SF_INFO info;
+  EXPECT_GT(readMono(full / "take.wav", info).size(), 4800u) << "no valid recording";
+  EXPECT_TRUE(temporaries(full).empty());
 }
 
 TEST_F(JackPlay, WithoutAServerRefusesInOneLineWithExitCode2) {

@@ -6,13 +6,17 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <csignal>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "usage_error.h"
 
 namespace {
 
@@ -79,6 +83,62 @@ TEST_F(AtomicFileTest, SignalRemovesEveryLiveTemporary) {
   EXPECT_TRUE(listing().empty());
 }
 
+// Every signal that would end the program by default removes the temporaries, not only the
+// usual three: a stray SIGUSR1, a SIGPIPE from a closed pipe, a timeout's SIGALRM.
+TEST_F(AtomicFileTest, EverySignalThatWouldEndTheProgramRemovesTheTemporaries) {
+  for (const int signal : AtomicFile::kEndingSignals) {
+    EXPECT_EXIT(threeOpenThenSignal(dir_, signal), ::testing::ExitedWithCode(128 + signal), "")
+        << ::strsignal(signal);
+    EXPECT_TRUE(listing().empty()) << ::strsignal(signal);
+  }
+}
+
+// A signal ignored by whoever started the program (nohup, trap '' HUP) stays ignored: the run
+// goes on and its file appears. A signal not ignored still removes the temporaries.
+void ignoredHangupThenCommit(const fs::path& dir) {
+  std::signal(SIGHUP, SIG_IGN);
+  AtomicFile a((dir / "a.csv").string(), "--out");
+  std::fputs("data\n", a.stream());
+  std::raise(SIGHUP);
+  a.commit();
+  std::raise(SIGUSR1);  // handled: ends the child, which removes nothing now (all published)
+}
+
+TEST_F(AtomicFileTest, AnInheritedIgnoreIsKept) {
+  EXPECT_EXIT(ignoredHangupThenCommit(dir_), ::testing::ExitedWithCode(128 + SIGUSR1), "");
+  EXPECT_EQ(slurp(path("a.csv")), "data\n");
+  EXPECT_EQ(listing(), std::vector<std::string>{"a.csv"});
+}
+
+// A run killed by SIGKILL cannot clean up: its temporary, named after its PID, is removed by the
+// next run that writes the same file once that PID is gone — and only then: a temporary of a
+// live process (here this test's own PID), or another file, is left alone.
+void openThenKill(const fs::path& dir) {
+  AtomicFile a((dir / "a.wav").string(), "-o");
+  std::fputs("half a take", a.stream());
+  std::fflush(a.stream());
+  std::raise(SIGKILL);
+}
+
+TEST_F(AtomicFileTest, ATemporaryLeftBySigkillIsRemovedByTheNextRun) {
+  EXPECT_EXIT(openThenKill(dir_), ::testing::KilledBySignal(SIGKILL), "");
+  ASSERT_EQ(listing().size(), 1u);
+  const std::string stale = listing().front();
+  EXPECT_TRUE(stale.starts_with("a.wav.tmp-")) << stale;
+  const std::string live = "a.wav.tmp-" + std::to_string(::getpid()) + "-abcdef";
+  { std::ofstream(path(live)) << "a live run's"; }
+  { std::ofstream(path("a.wav.tmp-notes.txt")) << "someone's"; }
+  AtomicFile again(path("a.wav"), "-o");
+  std::fputs("whole", again.stream());
+  again.commit();
+  std::vector<std::string> names = listing();
+  std::sort(names.begin(), names.end());
+  std::vector<std::string> kept = {"a.wav", "a.wav.tmp-notes.txt", live};
+  std::sort(kept.begin(), kept.end());
+  EXPECT_EQ(names, kept);
+  EXPECT_EQ(slurp(path("a.wav")), "whole");
+}
+
 TEST_F(AtomicFileTest, CommitTogetherPublishesEveryFile) {
   AtomicFile a(path("a.csv"), "--out"), b(path("b.csv"), "--snapshot-out");
   std::fputs("a\n", a.stream());
@@ -118,6 +178,53 @@ TEST_F(AtomicFileTest, AFinishedFileIsOnlyPublishedOnRequest) {
   EXPECT_THROW(b.publish(), std::logic_error);
   b.commit();
   EXPECT_EQ(listing(), std::vector<std::string>{"b.csv"});
+}
+
+// A symlink to nothing is neither followed (that would create a file wherever it points) nor
+// replaced (the link may be what someone meant to keep): refused, naming the flag and the link.
+TEST_F(AtomicFileTest, ADanglingSymlinkIsRefusedAndKept) {
+  fs::create_symlink(dir_ / "missing.csv", dir_ / "link.csv");
+  try {
+    AtomicFile file(path("link.csv"), "--out");
+    FAIL() << "expected UsageError";
+  } catch (const hamiltone::cli::UsageError& e) {
+    EXPECT_NE(std::string(e.what()).find("--out = " + path("link.csv")), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("does not exist"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(fs::is_symlink(dir_ / "link.csv"));
+  EXPECT_EQ(listing(), std::vector<std::string>{"link.csv"});
+  // A link to an existing file is followed: the file is replaced, the link kept.
+  { std::ofstream(path("target.csv")) << "old\n"; }
+  fs::remove(dir_ / "link.csv");
+  fs::create_symlink(dir_ / "target.csv", dir_ / "link.csv");
+  AtomicFile file(path("link.csv"), "--out");
+  std::fputs("new\n", file.stream());
+  file.commit();
+  EXPECT_TRUE(fs::is_symlink(dir_ / "link.csv"));
+  EXPECT_EQ(slurp(path("target.csv")), "new\n");
+}
+
+// An output that is one of the inputs — by the same path, another spelling or a link — is refused
+// naming both flags; a different file, or an input not given (empty), is not.
+TEST_F(AtomicFileTest, AnInputAsOutputIsRefused) {
+  using hamiltone::cli::refuseInputAsOutput;
+  { std::ofstream(path("in.toml")) << "x\n"; }
+  fs::create_symlink(dir_ / "in.toml", dir_ / "link.wav");
+  const std::vector<hamiltone::cli::InputFile> inputs = {{"--midi", ""},
+                                                         {"--preset", path("in.toml")}};
+  for (const std::string& out :
+       {path("in.toml"), (dir_ / "." / "in.toml").string(), path("link.wav")}) {
+    try {
+      refuseInputAsOutput("-o", out, inputs);
+      ADD_FAILURE() << out << ": expected UsageError";
+    } catch (const hamiltone::cli::UsageError& e) {
+      EXPECT_NE(std::string(e.what()).find("-o = " + out), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("--preset = " + path("in.toml")), std::string::npos)
+          << e.what();
+    }
+  }
+  EXPECT_NO_THROW(refuseInputAsOutput("-o", path("out.wav"), inputs));
 }
 
 TEST_F(AtomicFileTest, TooManyAtOnceIsAnErrorThatLeavesNoTemporary) {

@@ -14,8 +14,10 @@
 #include <string>
 #include <vector>
 
+#include "support/riff_chunks.h"
 #include "support/run_command.h"
 #include "support/spectrum.h"
+#include "support/tiny_disk.h"
 
 namespace {
 
@@ -93,6 +95,28 @@ TEST_F(RenderCli, WritesTheRequestedRateChannelsFormatAndLength) {
     EXPECT_EQ(f.info.format & SF_FORMAT_SUBMASK,
               std::string(format) == "pcm24" ? SF_FORMAT_PCM_24 : SF_FORMAT_FLOAT);
     EXPECT_EQ(f.info.frames, 48000);
+  }
+}
+
+// The same command twice gives the same file, byte for byte, in every format: the chunks are
+// the format, (for float) the frame count, zero padding and the samples — nothing that records
+// when.
+TEST_F(RenderCli, TwoRendersAreTheSameBytesInEveryFormat) {
+  for (const char* format : {"pcm16", "pcm24", "float32"}) {
+    std::string bytes[2];
+    for (std::string& b : bytes) {
+      const Result r =
+          run("--preset " + preset("paper-c3-string") +
+              " --notes C3:100:0.1 --tail 0 --quiet --format " + format + " -o " + wav());
+      ASSERT_EQ(r.exitCode, 0) << r.err;
+      b = hamiltone::testing::fileBytes(wav());
+    }
+    EXPECT_EQ(bytes[0], bytes[1]) << format;
+    const std::vector<std::string> ids = hamiltone::testing::riffChunkIds(bytes[0]);
+    ASSERT_FALSE(ids.empty()) << format;
+    for (const std::string& id : ids)
+      EXPECT_TRUE(id == "fmt " || id == "fact" || id == "PAD " || id == "data")
+          << format << ": chunk " << id;
   }
 }
 
@@ -179,6 +203,76 @@ TEST_F(RenderCli, RefusesABadSetNamingItAndWritesNothing) {
   expectRefused(" --preset " + preset("grand-piano") +
                     " --notes C3 --set scheme.grid_rule=longitudinal --set scheme.oversampling=1",
                 "(with --set scheme.grid_rule=longitudinal, --set scheme.oversampling=1)");
+}
+
+// -o naming an input (the MIDI file, a preset — by its path or through a link) would destroy it,
+// and a symlink to nothing would create a file where the link points, or replace the link:
+// each is refused before any work, naming -o, and every file is left as it was.
+TEST_F(RenderCli, RefusesAnOutputThatIsAnInputOrADanglingSymlink) {
+  const fs::path midi = dir_ / "in.mid", toml = dir_ / "in.toml", link = dir_ / "link.wav";
+  fs::copy_file(HAMILTONE_SOURCE_DIR "/presets/demo.mid", midi);
+  fs::copy_file(preset("paper-c3-string"), toml);
+  const std::string midiBytes = hamiltone::testing::fileBytes(midi);
+  const std::string tomlBytes = hamiltone::testing::fileBytes(toml);
+  const auto expectRefusedOutput = [&](const std::string& args, const fs::path& out,
+                                       const std::string& mention) {
+    const Result r = run(args + " --quiet -o " + out.string());
+    EXPECT_EQ(r.exitCode, 2) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find("-o = " + out.string()), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(mention), std::string::npos) << r.err;
+    EXPECT_EQ(hamiltone::testing::fileBytes(midi), midiBytes) << args;
+    EXPECT_EQ(hamiltone::testing::fileBytes(toml), tomlBytes) << args;
+  };
+  expectRefusedOutput("--preset " + toml.string() + " --midi " + midi.string(), midi, "--midi");
+  expectRefusedOutput("--preset " + toml.string() + " --notes C3", toml, "--preset");
+  fs::create_symlink(toml, link);
+  expectRefusedOutput("--preset " + toml.string() + " --notes C3", link, "--preset");
+  fs::remove(link);
+  fs::create_symlink(dir_ / "nowhere" / "x.wav", link);
+  expectRefusedOutput("--preset " + toml.string() + " --notes C3", link, "does not exist");
+  EXPECT_TRUE(fs::is_symlink(link));
+  fs::remove(link);
+  fs::create_symlink(dir_ / "missing.wav", link);
+  expectRefusedOutput("--preset " + toml.string() + " --notes C3", link, "does not exist");
+  EXPECT_TRUE(fs::is_symlink(link));
+  EXPECT_FALSE(fs::exists(dir_ / "missing.wav"));
+  std::size_t files = 0;
+  for ([[maybe_unused]] const auto& entry : fs::directory_iterator(dir_)) ++files;
+  EXPECT_EQ(files, 3u);  // the inputs and the link: no temporary
+}
+
+// A preset the guard has to silence renders noise, or silence, where notes were asked for: the
+// output is known to be wrong, so none is written, the exit code is 2 (bad input) and the message
+// names the preset and the parameter at fault. Here the gauge shift ε = 10⁶ J, far above the
+// energies of a struck string (~10⁻² J), which with any check on ε at load gives the same result.
+TEST_F(RenderCli, AnUnstablePresetIsAnErrorAndWritesNothing) {
+  std::string text = hamiltone::testing::fileBytes(preset("paper-c3-string"));
+  const std::string was = "epsilon_J = 0.0 ";
+  ASSERT_NE(text.find(was), std::string::npos);
+  text.replace(text.find(was), was.size(), "epsilon_J = 1e6 ");
+  const fs::path unstable = dir_ / "unstable.toml";
+  std::ofstream(unstable) << text;
+  const Result r =
+      run("--preset " + unstable.string() + " --notes C3:127:0.5 --tail 0 -o " + wav());
+  EXPECT_EQ(r.exitCode, 2) << r.err;
+  EXPECT_NE(r.err.find("unstable.toml"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("epsilon_J"), std::string::npos) << r.err;
+  for (const auto& entry : fs::directory_iterator(dir_))  // the preset, no WAV, no temporary
+    EXPECT_EQ(entry.path().filename().string().find("out.wav"), std::string::npos);
+}
+
+// A full disk is an I/O error: exit 1, the message names the file, and neither it nor a temporary
+// is left (docs/failure-behaviour.md). 1 s of pcm24 stereo is 288 kB, more than the 64 KiB disk.
+TEST_F(RenderCli, AFullDiskIsAnIoErrorAndLeavesNoFile) {
+  const fs::path full = dir_ / "full";
+  hamiltone::test::TinyDisk disk(full);
+  if (!disk.mounted()) GTEST_SKIP() << "cannot mount a 64 KiB tmpfs here (needs root)";
+  const fs::path out = full / "out.wav";
+  const Result r = run("--preset " + preset("paper-c3-string") +
+                       " --notes C3 --tail 0 --quiet -o " + out.string());
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_NE(r.err.find(out.string()), std::string::npos) << r.err;
+  EXPECT_TRUE(fs::is_empty(full));
 }
 
 TEST_F(RenderCli, ListsTheParameterTable) {

@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -152,6 +153,52 @@ TEST_F(SimCli, RefusesStartsAndOutputsBeyondDoublePrecision) {
 }
 
 // Killed mid-run, the program leaves neither the output nor its temporary.
+// Messages name the flag at fault and print computed numbers to a few digits: not a step count
+// in 300 fixed-point digits, a NaN as "-nan", or "--duration / --k" for a --k longer than the run.
+TEST_F(SimCli, MessagesNameTheFlagAtFaultWithReadableNumbers) {
+  const struct {
+    std::string args, mention;
+  } cases[] = {
+      {"fpu --scheme sav --k 1e300", "--k = 1e+300 s: longer than --duration = 1 s"},
+      {"fpu --scheme sav --duration 1e300", "--duration / --k = 1e+303 steps"},
+      {"particle --k 1e-300", "--duration / --k = 1e+300 steps"},
+      {"string --k 1e-300 --duration 1e-299", "the grid would have 2.364e+296 segments"},
+      {"string --alpha 1e300", "energy is NaN"},
+      {"plate --thickness 1e-300", "is NaN"},
+      {"plate --poisson 1e300", "--poisson = 1e300"},
+      {"plate --young 1e300", "h = 1.653e+70 m"},
+  };
+  const std::regex longNumber("[0-9]{10,}");
+  for (const auto& c : cases) {
+    const hamiltone::test::CliResult r = run(c.args + " --out " + path("out.csv"));
+    EXPECT_EQ(r.exitCode, 2) << c.args << "\n" << r.err;
+    EXPECT_NE(r.err.find(c.mention), std::string::npos) << c.args << "\n" << r.err;
+    EXPECT_EQ(r.err.find("nan"), std::string::npos) << c.args << "\n" << r.err;
+    EXPECT_FALSE(std::regex_search(r.err, longNumber)) << c.args << "\n" << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+  EXPECT_TRUE(std::filesystem::is_empty(dir_));
+}
+
+// A run that would take days is refused before it starts, with the estimate, unless asked for:
+// --allow-long-run lifts the limit (here the next check, an unwritable --out, then speaks).
+TEST_F(SimCli, RefusesARunThatWouldTakeTooLongUnlessAllowed) {
+  timeout_ = "timeout 120 ";
+  const std::string fpu =
+      "fpu --scheme sav --pairs 1000000 --k 1e-6 --duration 100 --every 1000000000";
+  const std::string wave = "wave --dx 1e-6 --k 1e-7 --duration 10 --every 1000000000";
+  for (const std::string& args : {fpu, wave}) {
+    for (const char* mention : {"days", "--allow-long-run", "per second"})
+      expectRefused(args + " --out " + path("out.csv"), mention);
+    expectRefused(args + " --allow-long-run --out " + path("no-dir/out.csv"), "--out");
+  }
+  expectRefused(
+      "fpu --scheme marazzato --quadrature gl5 --pairs 1000000 --k 1e-3 --duration 1000 "
+      "--every 1000000000 --out " +
+          path("out.csv"),
+      "--allow-long-run");
+}
+
 TEST_F(SimCli, InterruptedRunLeavesNoFile) {
   const std::string cmd = std::string(HAMILTONE_SIM) +
                           " fpu --scheme sav --pairs 1000 --duration 1e4 --every 1000 --out " +

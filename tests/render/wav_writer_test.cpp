@@ -19,6 +19,7 @@
 #include <tuple>
 #include <vector>
 
+#include "support/riff_chunks.h"
 #include "usage_error.h"
 
 namespace {
@@ -125,6 +126,30 @@ INSTANTIATE_TEST_SUITE_P(RatesFormatsChannels, WavRoundTrip,
                                                               SampleFormat::pcm24,
                                                               SampleFormat::float32),
                                             ::testing::Values(1, 2)));
+
+// The same samples give the same bytes, in every format: no chunk carries the time of writing
+// (libsndfile's PEAK chunk, added to float files by default, does; its zero-filled PAD chunk, which
+// aligns the data, does not). Two files written within one second agree even with a time stamp,
+// so the chunk list is what tells.
+TEST_F(WavWriterTest, SameSamplesGiveTheSameBytesInEveryFormat) {
+  const std::vector<float> samples = {0.0f, 0.5f, -0.25f, 1.0f, -1.0f, 0.125f};
+  for (const SampleFormat format :
+       {SampleFormat::pcm16, SampleFormat::pcm24, SampleFormat::float32}) {
+    std::string bytes[2];
+    for (std::string& b : bytes) {
+      WavWriter writer(wav().string(), "-o", 48000, 2, format);
+      writer.write(samples.data(), samples.size() / 2);
+      writer.commit();
+      b = hamiltone::testing::fileBytes(wav());
+    }
+    const int f = static_cast<int>(format);
+    EXPECT_EQ(bytes[0], bytes[1]) << "format " << f;
+    for (const std::string& id : hamiltone::testing::riffChunkIds(bytes[0]))
+      EXPECT_TRUE(id == "fmt " || id == "fact" || id == "PAD " || id == "data")
+          << "format " << f << ": chunk \"" << id << "\"";
+    EXPECT_EQ(hamiltone::testing::riffChunkIds(bytes[0]).back(), "data") << "format " << f;
+  }
+}
 
 // NaN and ±Inf become silence, the rest is clamped to full scale.
 const std::vector<float> kBadSamples = {std::numeric_limits<float>::quiet_NaN(),

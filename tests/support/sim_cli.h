@@ -3,7 +3,6 @@
 #pragma once
 
 #include <gtest/gtest.h>
-#include <sys/mount.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -16,31 +15,13 @@
 #include <string>
 #include <vector>
 
+#include "support/tiny_disk.h"
+
 namespace hamiltone::test {
 
 struct CliResult {
   int exitCode;
   std::string out, err;
-};
-
-// A full disk to write to: a 64 KiB tmpfs mounted on `dir` while alive. Needs root (or
-// CAP_SYS_ADMIN); mounted() is false where that fails, and the test should skip.
-class TinyDisk {
- public:
-  explicit TinyDisk(const std::filesystem::path& dir) : dir_(dir) {
-    std::filesystem::create_directories(dir_);
-    mounted_ = ::geteuid() == 0 && ::mount("tmpfs", dir_.c_str(), "tmpfs", 0, "size=64k") == 0;
-  }
-  ~TinyDisk() {
-    if (mounted_) ::umount2(dir_.c_str(), MNT_DETACH);
-  }
-  TinyDisk(const TinyDisk&) = delete;
-  TinyDisk& operator=(const TinyDisk&) = delete;
-  bool mounted() const { return mounted_; }
-
- private:
-  std::filesystem::path dir_;
-  bool mounted_ = false;
 };
 
 class SimCliTest : public ::testing::Test {
@@ -63,8 +44,8 @@ class SimCliTest : public ::testing::Test {
 
   // `hamiltone-sim [SUBCOMMAND] ARGS` with stdin closed; the scratch directory is left as it was.
   CliResult run(const std::string& args) {
-    const std::string cmd = std::string(HAMILTONE_SIM) + " " + subcommand_ + args + " >" +
-                            path("stdout") + " 2>" + path("stderr") + " </dev/null";
+    const std::string cmd = timeout_ + std::string(HAMILTONE_SIM) + " " + subcommand_ + args +
+                            " >" + path("stdout") + " 2>" + path("stderr") + " </dev/null";
     const int status = std::system(cmd.c_str());
     CliResult r{WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(path("stdout")),
                 slurp(path("stderr"))};
@@ -124,6 +105,9 @@ class SimCliTest : public ::testing::Test {
 
   std::filesystem::path dir_;
   std::string subcommand_;  // "wave ", "string ", …: put before every run's ARGS, if set
+  // "timeout 60 ": for a test whose command would run for ever where the code under test is
+  // wrong, so that it fails (exit 124) instead of hanging.
+  std::string timeout_;
 };
 
 }  // namespace hamiltone::test
