@@ -108,6 +108,13 @@ class SavScheme {
     curr_[i] = qNext;
   }
 
+  // After a change of K between steps (a string retensioned by the pitch bend): K q^n is taken
+  // again, so energy() reports H of the new K on the same state. The difference is the work the
+  // change did, which the next steps then conserve.
+  void stiffnessChanged() noexcept {
+    if constexpr (splitK) system_.applyStiffness(prev_, kq_);
+  }
+
   // Sets ψ_j^{n+½} back to sqrt(2 (V'_j(q^{n+½}) + ε)), q^{n+½} = (q^n + q^{n+1})/2, dropping
   // the O(k²) residual ψ_j keeps once its part goes slack (a hammer after the strike). The
   // energy changes by what the residual held, which energy() then reports.

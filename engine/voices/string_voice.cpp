@@ -202,11 +202,16 @@ void StringVoice::setBend(double semitones) noexcept {
 }
 
 // f1 = (1/πk) arcsin(k sqrt(λ1)/2) (schemePartial) with λ1 = β·bendSlope_ + bendOffset_: the β
-// that puts f1 at fundamental·2^(bend/12).
+// that puts f1 at fundamental·2^(bend/12). Retensioning a moving string does work on it (½ q K q
+// changes with β): it is counted with what the strikes put in, so the guard, which compares the
+// energy with that, sees only a real instability however fast the wheel moves.
 void StringVoice::applyBend() noexcept {
   const double f = fundamental_ * std::pow(2.0, bend_ / 12.0);
   const double root = 2.0 / k_ * std::sin(std::numbers::pi * k_ * f);
+  const double before = energy();
   scheme_->system().string().setTensionScale((root * root - bendOffset_) / bendSlope_);
+  scheme_->stiffnessChanged();
+  injected_ += energy() - before;
 }
 
 int StringVoice::segments() const { return scheme_->system().string().segments(); }

@@ -76,7 +76,7 @@ class StringVoice {
 
   bool active() const { return active_; }
   double energy() const;  // the scheme's H^{n+½} (ε excluded), J
-  double injectedEnergy() const { return injected_; }
+  double injectedEnergy() const { return injected_; }  // by the strikes and the bend's retensioning
   // Taken out by the back-check (the hammer's kinetic energy and its ψ residual). The string's
   // losses are not tallied on the audio path; with them off, energy() + removedEnergy() stays
   // injectedEnergy().
