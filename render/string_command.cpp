@@ -36,8 +36,10 @@ CLI::App* addStringCommand(CLI::App& app, StringArguments& a) {
       ->capture_default_str();
   cmd->add_option("--grid", a.grid,
                   "longitudinal: h >= sqrt(E/ρ) k (the paper's); transverse: the finest grid the "
-                  "stiff-string bound (44) allows")
-      ->check(CLI::IsMember({"longitudinal", "transverse"}))
+                  "stiff-string bound (44) allows; two-grid: u on the transverse grid sized for "
+                  "--tension-margin·T0, v on a coarse grid nested in it with h_v >= 1.05 "
+                  "sqrt(E/ρ) k (SCHEMES §3b, the voices' default)")
+      ->check(CLI::IsMember({"longitudinal", "transverse", "two-grid"}))
       ->capture_default_str();
   cmd->add_option("--stiffness", a.stiffness, "bending stiffness EI, I = πr⁴/4 of the section")
       ->check(CLI::IsMember({"on", "off"}))
@@ -48,6 +50,8 @@ CLI::App* addStringCommand(CLI::App& app, StringArguments& a) {
   };
   number("--k", a.k, "SECONDS", "time step (> 0)");
   number("--grid-factor", a.gridFactor, "NUMBER", "multiplies the rule's minimal h (>= 1)");
+  number("--tension-margin", a.tensionMargin, "NUMBER",
+         "two-grid: u's grid sized for this multiple of T0 (1 … 4)");
   cmd->add_option("--segments", a.segments,
                   "number of grid segments M, instead of the grid rule (a fixed grid for "
                   "convergence in k)")
@@ -89,18 +93,22 @@ CLI::App* addStringCommand(CLI::App& app, StringArguments& a) {
 
 namespace {
 
+// u at grid point `probe` of u's grid, v at point `probeV` of v's (−1: v has no interior point).
+struct Probe {
+  Eigen::Index u = 0, v = -1;
+};
+
 template <class Scheme>
-RunSummary simulate(Scheme& scheme, Eigen::Index probe, long steps, long every, std::FILE* out,
+RunSummary simulate(Scheme& scheme, Probe probe, long steps, long every, std::FILE* out,
                     Snapshots* snapshots) {
-  const Eigen::Index longitudinal = scheme.system().size() / 2;  // u then v (then the hammer)
   Snapshotting<Scheme> watched(scheme, snapshots);
   std::fprintf(out, "t,u,v,energy,psi\n");
   return runToCsv(
       watched, steps, every, out,
       [&](const Snapshotting<Scheme>& w, const Energy& e, std::FILE* f) {
         const Scheme& s = w.scheme();
-        writeNumber(f, s.q()[probe]);
-        writeNumber(f, s.q()[probe + longitudinal]);
+        writeNumber(f, s.q()[probe.u]);
+        writeNumber(f, probe.v >= 0 ? s.q()[probe.v] : 0.0);
         writeNumber(f, e.total());
         if constexpr (requires { s.psi(); })
           writeNumber(f, s.psi());
@@ -112,7 +120,7 @@ RunSummary simulate(Scheme& scheme, Eigen::Index probe, long steps, long every, 
 
 template <class System>
 RunSummary run(const std::string& scheme, const System& system, const InitialState& start,
-               const StepParameters& params, Eigen::Index probe, long steps, long every,
+               const StepParameters& params, Probe probe, long steps, long every,
                std::FILE* out, Snapshots* snapshots) {
   if (scheme == "sv") {
     auto sv = building([&] { return StormerVerlet<System>(system, params, start); });
@@ -167,13 +175,31 @@ int runStringCommand(const StringArguments& a) {
   const std::vector<long> wanted =
       a.snapshots.empty() ? std::vector<long>{} : snapshotSteps(a.snapshots, k, steps);
 
-  const GridRule rule = a.grid == "transverse" ? GridRule::transverse : GridRule::longitudinal;
-  const int segments =
-      a.segments.empty() ? building([&] { return gridSegments(physics, rule, k, sigma1, factor); })
-                         : static_cast<int>(parseInteger("--segments", a.segments, 2, 1'000'000));
-  const NonlinearString string = building([&] { return NonlinearString(physics, segments); });
-  const Eigen::Index probeIndex =
-      std::clamp<Eigen::Index>(std::lround(probe * segments) - 1, 0, segments - 2);
+  const GridRule rule = a.grid == "transverse" ? GridRule::transverse
+                        : a.grid == "two-grid"   ? GridRule::twoGrid
+                                                 : GridRule::longitudinal;
+  const double margin = parseReal("--tension-margin", a.tensionMargin, Range::positive);
+  if (margin < 1.0 || margin > 4.0)
+    throw UsageError("--tension-margin = " + a.tensionMargin + ": out of range; expected 1 … 4");
+  if (!a.segments.empty() && rule == GridRule::twoGrid)
+    throw UsageError("--segments = " + a.segments +
+                     ": fixes one grid for u and v; --grid two-grid sizes its two from k");
+  const StringGrid grid =
+      a.segments.empty()
+          ? building([&] { return stringGrid(physics, rule, k, sigma1, factor, margin); })
+          : StringGrid{static_cast<int>(parseInteger("--segments", a.segments, 2, 1'000'000)),
+                       0};
+  const int segments = grid.transverse;
+  const NonlinearString string = building([&] {
+    return NonlinearString(physics, StringGrid{segments, grid.longitudinal ? grid.longitudinal
+                                                                           : segments});
+  });
+  const int cells = string.grid().longitudinal;
+  const Probe probeIndex{
+      std::clamp<Eigen::Index>(std::lround(probe * segments) - 1, 0, segments - 2),
+      cells < 2 ? -1
+                : string.transverseSize() +
+                      std::clamp<Eigen::Index>(std::lround(probe * cells) - 1, 0, cells - 2)};
   const StepParameters params{.k = k, .sigma0 = sigma0, .sigma1 = sigma1, .epsilon = epsilon};
 
   if (!wanted.empty())
@@ -184,24 +210,32 @@ int runStringCommand(const StringArguments& a) {
   if (!wanted.empty()) {
     snapshotFile.emplace(a.snapshotOut, "--snapshot-out");
     // t,x,u,v at x = j h, j = 0..M, zero at the fixed ends; q holds u then v (then the hammer).
+    // On two grids v is linear in each coarse cell of r fine segments (its strain is the cell's).
     const Eigen::Index interior = segments - 1;
+    const int r = segments / cells;
     const double h = string.spacing();
     snapshots.emplace(
         wanted, "t,x,u,v",
-        [segments, interior, h](std::FILE* f, double t, const Vector& q) {
+        [segments, interior, r, h](std::FILE* f, double t, const Vector& q) {
+          auto v = [&](int coarse) {  // v at coarse point J, 0 at the ends
+            return coarse == 0 || coarse * r == segments ? 0.0 : q[interior + coarse - 1];
+          };
           for (int j = 0; j <= segments; ++j) {
             const bool end = j == 0 || j == segments;
+            const int cell = std::min(j / r, segments / r - 1);
+            const double frac = static_cast<double>(j - cell * r) / r;
             std::fprintf(f, "%.17g", t);
             writeNumber(f, j * h);
             writeNumber(f, end ? 0.0 : q[j - 1]);
-            writeNumber(f, end ? 0.0 : q[j - 1 + interior]);
+            writeNumber(f, (1.0 - frac) * v(cell) + frac * v(cell + 1));
             std::fputc('\n', f);
           }
         },
         snapshotFile->stream());
   }
   Snapshots* watcher = snapshots ? &*snapshots : nullptr;
-  std::fprintf(file.stream(), "# segments=%d h=%.17g k=%.17g\n", segments, string.spacing(), k);
+  std::fprintf(file.stream(), "# segments=%d h=%.17g k=%.17g longitudinal_segments=%d h_v=%.17g\n",
+               segments, string.spacing(), k, cells, string.longitudinalSpacing());
   RunSummary summary;
   const Eigen::Index n = string.size();
   if (hammerVelocity > 0.0) {

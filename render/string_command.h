@@ -12,7 +12,7 @@ namespace hamiltone::cli {
 struct StringArguments {
   std::string scheme = "sav-split", grid = "longitudinal", stiffness = "off";
   std::string k = "2.6e-7", gridFactor = "1.05", alpha = "300", epsilon = "0", duration = "0.01";
-  std::string probe = "0.5", every = "1", hammerVelocity = "0", segments;
+  std::string probe = "0.5", every = "1", hammerVelocity = "0", segments, tensionMargin = "1.5";
   std::string density = "7850", area = "8.87e-7", length = "1.259", young = "2.02e11",
               tension = "759";
   std::string sigma0 = "0", sigma1 = "0";

@@ -229,6 +229,44 @@ TEST_F(SimCli, StringWritesTheDocumentedCsv) {
   }
 }
 
+// The voices' two grids from the research CLI: the paper's C3 (no stiffness) at 48 kHz has 11 coarse
+// cells (floor(L / (1.05 c_L k))) and u's grid at 1.5 T0 rounded down to a multiple of them; the
+// comment line says both; a first-mode start at α = 10 (with a gauge shift, SCHEMES §3b) conserves
+// (41); the snapshot's v is linear between the coarse points; --segments fixes one grid, so it is
+// refused with the two.
+TEST_F(SimCli, StringOnTwoGrids) {
+  const std::string snaps = path("snaps.csv");
+  const CliResult r = run("string --grid two-grid --k 2.0833333333333333e-05 --alpha 10 --epsilon "
+                          "0.01 --duration 0.01 --every 48 --snapshots 0.005 --snapshot-out " +
+                          snaps + " --out " + csv());
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  std::istringstream text(slurp(csv()));
+  std::string comment;
+  std::getline(text, comment);
+  EXPECT_NE(comment.find(" longitudinal_segments=11 "), std::string::npos) << comment;
+  const int segments = std::stoi(comment.substr(comment.find('=') + 1));
+  EXPECT_EQ(segments % 11, 0) << comment;
+  EXPECT_LT(segments, 136);  // the T0 bound's grid: u is sized for 1.5 T0
+  std::string rest((std::istreambuf_iterator<char>(text)), std::istreambuf_iterator<char>());
+  std::string header;
+  const auto rows = parseCsv(rest, header);
+  ASSERT_EQ(rows.size(), 11u);  // 480 steps, every 48
+  for (const auto& row : rows) EXPECT_NEAR(row[3], rows[0][3], 1e-10 * rows[0][3]);
+  std::string snapHeader;
+  const auto nodes = parseCsv(slurp(snaps), snapHeader);
+  ASSERT_EQ(nodes.size(), static_cast<size_t>(segments + 1));
+  const int cell = segments / 11;  // fine segments per coarse cell
+  for (int j = 1; j < cell; ++j)   // inside the first cell, v is on the line from 0 to v(x_1)
+    EXPECT_NEAR(nodes[j][3], nodes[cell][3] * j / cell, 1e-12 * std::abs(nodes[cell][3]) + 1e-300)
+        << j;
+  EXPECT_NE(nodes[cell][3], 0.0);
+  std::filesystem::remove(csv());
+  std::filesystem::remove(snaps);
+  expectRefused("string --grid two-grid --segments 40 --out " + csv(), "--segments = 40");
+  expectRefused("string --grid two-grid --tension-margin 0.5 --out " + csv(),
+                "--tension-margin = 0.5: out of range");
+}
+
 // The implicit reference (67)–(68) writes the same columns and conserves its energy; its u tracks
 // the split scheme's on the same grid and step.
 TEST_F(SimCli, StringImplicitReferenceWritesTheSameCsv) {
