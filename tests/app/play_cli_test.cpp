@@ -12,6 +12,7 @@
 
 #include "support/riff_chunks.h"
 #include "support/run_command.h"
+#include "support/scratch_dir.h"
 
 namespace {
 
@@ -24,13 +25,6 @@ std::string preset(const char* name) {
 
 class PlayCli : public ::testing::Test {
  protected:
-  void SetUp() override {
-    std::string pattern = (fs::temp_directory_path() / "hamiltone-play-cli-XXXXXX").string();
-    ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
-    dir_ = pattern;
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
   // hamiltone-play --api jack ARGS with a JACK server name of its own that no server has, so a
   // developer's JACK server is never met and none is started.
   CommandResult play(const std::string& args) const {
@@ -41,7 +35,8 @@ class PlayCli : public ::testing::Test {
                                           dir_ / "stderr");
   }
 
-  fs::path dir_;
+  hamiltone::testing::ScratchDir scratch_{"hamiltone-play-cli"};
+  const fs::path dir_ = scratch_.path();
 };
 
 TEST_F(PlayCli, RefusesABadSetBeforeOpeningAnyDevice) {

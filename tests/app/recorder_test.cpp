@@ -15,6 +15,7 @@
 #include <thread>
 #include <vector>
 
+#include "support/scratch_dir.h"
 #include "support/tiny_disk.h"
 
 namespace hamiltone::app {
@@ -27,15 +28,6 @@ constexpr size_t kBlock = 480;  // frames the audio thread pushes at once
 
 class RecorderTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("hamiltone-recorder-" + std::to_string(::getpid()) + "-" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
   // Frame i of a stereo test signal: distinct channels, well inside full scale.
   static float sample(size_t i, int channel) {
     const double phase = 2.0 * 3.141592653589793 * 441.0 * static_cast<double>(i) / kRate;
@@ -70,7 +62,8 @@ class RecorderTest : public ::testing::Test {
     return names;
   }
 
-  fs::path dir_;
+  hamiltone::testing::ScratchDir scratch_{"hamiltone-recorder"};
+  const fs::path dir_ = scratch_.path();
 };
 
 // Writes to the file `recorder` is writing fail as on a full disk from now on: the descriptor of

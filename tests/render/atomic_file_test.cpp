@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "support/scratch_dir.h"
 #include "usage_error.h"
 
 namespace {
@@ -26,15 +27,6 @@ using hamiltone::cli::commitTogether;
 
 class AtomicFileTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("hamiltone-atomic-" + std::to_string(::getpid()) + "-" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
   std::string path(const std::string& name) const { return (dir_ / name).string(); }
   std::vector<std::string> listing() const {
     std::vector<std::string> names;
@@ -46,7 +38,8 @@ class AtomicFileTest : public ::testing::Test {
     return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   }
 
-  fs::path dir_;
+  hamiltone::testing::ScratchDir scratch_{"hamiltone-atomic"};
+  const fs::path dir_ = scratch_.path();
 };
 
 // Writes to `file` fail as on a full disk from now on: its descriptor becomes /dev/full.

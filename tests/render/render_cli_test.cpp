@@ -16,6 +16,7 @@
 
 #include "support/riff_chunks.h"
 #include "support/run_command.h"
+#include "support/scratch_dir.h"
 #include "support/spectrum.h"
 #include "support/tiny_disk.h"
 
@@ -32,15 +33,6 @@ struct Wav {
 
 class RenderCli : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("hamiltone-render-" + std::to_string(::getpid()) + "-" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
   Result run(const std::string& args) {
     return hamiltone::testing::runCommand(std::string(HAMILTONE_RENDER) + " " + args,
                                           dir_ / "stderr");
@@ -67,7 +59,8 @@ class RenderCli : public ::testing::Test {
       EXPECT_EQ(entry.path().filename().string().find("out.wav"), std::string::npos) << args;
   }
 
-  fs::path dir_;
+  hamiltone::testing::ScratchDir scratch_{"hamiltone-render"};
+  const fs::path dir_ = scratch_.path();
 };
 
 std::string preset(const char* name) {

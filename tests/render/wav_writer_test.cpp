@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "support/riff_chunks.h"
+#include "support/scratch_dir.h"
 #include "usage_error.h"
 
 namespace {
@@ -54,22 +55,10 @@ std::vector<std::string> listing(const fs::path& dir) {
 
 class WavWriterTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    std::string name = ::testing::UnitTest::GetInstance()->current_test_info()->name();
-    for (char& c : name)
-      if (c == '/') c = '_';  // parametrised tests are named "Case/3"
-    dir_ = fs::temp_directory_path() / ("hamiltone-wav-" + std::to_string(::getpid()) + "-" + name);
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override {
-    fs::permissions(dir_, fs::perms::owner_all, fs::perm_options::add);
-    fs::remove_all(dir_);
-  }
-
   fs::path wav() const { return dir_ / "out.wav"; }
 
-  fs::path dir_;
+  hamiltone::testing::ScratchDir scratch_{"hamiltone-wav"};
+  const fs::path dir_ = scratch_.path();
 };
 
 // Round trips at both common rates, in every format, mono and stereo.

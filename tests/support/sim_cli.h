@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "support/scratch_dir.h"
 #include "support/tiny_disk.h"
 
 namespace hamiltone::test {
@@ -26,16 +27,6 @@ struct CliResult {
 
 class SimCliTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("hamiltone-cli-" + std::to_string(::getpid()) + "-" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->test_suite_name() + "-" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    std::filesystem::remove_all(dir_);
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
-
   // `shell` run by /bin/sh; its exit code as the shell reports it (128 + N for a signal N).
   static int shell(const std::string& shell) {
     const int status = std::system(shell.c_str());
@@ -103,7 +94,8 @@ class SimCliTest : public ::testing::Test {
     return values;
   }
 
-  std::filesystem::path dir_;
+  hamiltone::testing::ScratchDir scratch_{"hamiltone-cli"};
+  const std::filesystem::path dir_ = scratch_.path();
   std::string subcommand_;  // "wave ", "string ", …: put before every run's ARGS, if set
   // "timeout 60 ": for a test whose command would run for ever where the code under test is
   // wrong, so that it fails (exit 124) instead of hanging.
