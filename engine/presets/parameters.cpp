@@ -462,11 +462,12 @@ constexpr Parameter kTable[] = {
     {.name = "scheme.oversampling",
      .type = integer,
      .min = 1,
-     .max = 16,
-     .choices = "1|2|4|8|16",
+     .max = 64,
+     .choices = "1|2|4|8|16|32|64",
      .defaultText = "1",
      .doc = "Scheme steps per output sample: a finer time step and grid, at that times the cost "
-            "or more."},
+            "or more. 32 and 64 are for converged string references (a short treble string on "
+            "the longitudinal grid at 16 has too few segments); a plate takes at most 16."},
     {.name = "scheme.grid_factor",
      .min = 1,
      .max = 100,

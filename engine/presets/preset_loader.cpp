@@ -110,7 +110,7 @@ bool inChoices(std::string_view choices, std::string_view word) {
   }
 }
 
-// "\"string\" or \"plate\"", "one of 1, 2, 4, 8, 16".
+// "\"string\" or \"plate\"", "one of 1, 2, 4, 8, 16, 32, 64".
 std::string listChoices(std::string_view choices, bool quoted) {
   std::vector<std::string> words;
   for (size_t start = 0; start <= choices.size();) {

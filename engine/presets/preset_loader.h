@@ -18,7 +18,7 @@ namespace hamiltone {
 //   FILE:LINE:COL: key = value: what is valid
 // e.g. "presets/x.toml:12:1: string.tension_n = 759: unknown key; did you mean string.tension_N?".
 // A line about a --set says it instead of LINE:COL: "presets/x.toml: --set scheme.oversampling=3:
-// expected one of 1, 2, 4, 8, 16". what() is the lines joined with '\n'.
+// expected one of 1, 2, 4, 8, 16, 32, 64". what() is the lines joined with '\n'.
 struct PresetError : std::runtime_error {
   explicit PresetError(std::vector<std::string> messages);
   std::vector<std::string> lines;

@@ -98,7 +98,8 @@ StringLoss stringLossFromT60(const StringPhysics& string, double t60Low, double 
 
 void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleRate) {
   const int r = patch.oversampling;
-  require(r == 1 || r == 2 || r == 4 || r == 8 || r == 16, "oversampling", r, "1, 2, 4, 8 or 16");
+  require(r == 1 || r == 2 || r == 4 || r == 8 || r == 16 || r == 32 || r == 64, "oversampling", r,
+          "1, 2, 4, 8, 16, 32 or 64");
   require(std::isfinite(sampleRate) && sampleRate >= 8000.0 && sampleRate <= 384000.0,
           "sample rate", sampleRate, "between 8000 and 384000 Hz");
   require(std::isfinite(patch.a4Hz) && patch.a4Hz >= 400.0 && patch.a4Hz <= 480.0, "a4_hz",

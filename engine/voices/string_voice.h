@@ -25,7 +25,7 @@ struct StringPatch {
   GridRule grid = GridRule::twoGrid;
   double gridFactor = 1.0;
   double tensionMargin = 1.5;  // two grids: u's grid sized for this multiple of T0 (SCHEMES §3b)
-  int oversampling = 1;  // 1, 2, 4, 8 or 16
+  int oversampling = 1;  // 1, 2, 4, 8, 16, 32 or 64
   // Gauge shift ε, J; none: kEpsilonShare of the hardest strike's energy ½ M_H v_max² where v's
   // grid resolves the longitudinal wave, 0 where it does not (docs/string-grids.md).
   std::optional<double> epsilon;

@@ -460,7 +460,7 @@ TEST(PresetOverrides, BadOverridesAreRefusedNamingTheSet) {
     const char* line;
   } cases[] = {
       {{"scheme.oversampling", "3"},
-       "test.toml: --set scheme.oversampling=3: expected one of 1, 2, 4, 8, 16"},
+       "test.toml: --set scheme.oversampling=3: expected one of 1, 2, 4, 8, 16, 32, 64"},
       {{"string.unisons", "4"}, "test.toml: --set string.unisons=4: out of range; expected 1 … 3"},
       {{"hammer.mass_kg", "heavy"}, "test.toml: --set hammer.mass_kg=heavy: expected a number"},
       {{"gain_dB", "nan"}, "test.toml: --set gain_dB=nan: not a finite number"},

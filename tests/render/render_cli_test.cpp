@@ -181,7 +181,7 @@ TEST_F(RenderCli, RefusesABadSetNamingItAndWritesNothing) {
   const std::string c3 = " --preset " + preset("paper-c3-string") + " --notes C3";
   expectRefused(
       c3 + " --set scheme.oversampling=3",
-      "paper-c3-string.toml: --set scheme.oversampling=3: expected one of 1, 2, 4, 8, 16");
+      "paper-c3-string.toml: --set scheme.oversampling=3: expected one of 1, 2, 4, 8, 16, 32, 64");
   expectRefused(c3 + " --set scheme.grid_rule=diagonal",
                 "--set scheme.grid_rule=diagonal: expected one of \"two-grid\", \"transverse\", "
                 "\"longitudinal\"");

@@ -290,7 +290,7 @@ TEST(Synth, RejectsBadSetups) {
     FAIL();
   } catch (const std::invalid_argument& e) {
     EXPECT_STREQ(e.what(),
-                 "pianoKeys(60, 60): note 60: oversampling = 3: must be 1, 2, 4, 8 or 16");
+                 "pianoKeys(60, 60): note 60: oversampling = 3: must be 1, 2, 4, 8, 16, 32 or 64");
   }
 }
 
