@@ -120,8 +120,8 @@ RunSummary simulate(Scheme& scheme, Probe probe, long steps, long every, std::FI
 
 template <class System>
 RunSummary run(const std::string& scheme, const System& system, const InitialState& start,
-               const StepParameters& params, Probe probe, long steps, long every,
-               std::FILE* out, Snapshots* snapshots) {
+               const StepParameters& params, Probe probe, long steps, long every, std::FILE* out,
+               Snapshots* snapshots) {
   if (scheme == "sv") {
     auto sv = building([&] { return StormerVerlet<System>(system, params, start); });
     return simulate(sv, probe, steps, every, out, snapshots);
@@ -176,8 +176,8 @@ int runStringCommand(const StringArguments& a) {
       a.snapshots.empty() ? std::vector<long>{} : snapshotSteps(a.snapshots, k, steps);
 
   const GridRule rule = a.grid == "transverse" ? GridRule::transverse
-                        : a.grid == "two-grid"   ? GridRule::twoGrid
-                                                 : GridRule::longitudinal;
+                        : a.grid == "two-grid" ? GridRule::twoGrid
+                                               : GridRule::longitudinal;
   const double margin = parseReal("--tension-margin", a.tensionMargin, Range::positive);
   if (margin < 1.0 || margin > 4.0)
     throw UsageError("--tension-margin = " + a.tensionMargin + ": out of range; expected 1 … 4");
@@ -187,12 +187,11 @@ int runStringCommand(const StringArguments& a) {
   const StringGrid grid =
       a.segments.empty()
           ? building([&] { return stringGrid(physics, rule, k, sigma1, factor, margin); })
-          : StringGrid{static_cast<int>(parseInteger("--segments", a.segments, 2, 1'000'000)),
-                       0};
+          : StringGrid{static_cast<int>(parseInteger("--segments", a.segments, 2, 1'000'000)), 0};
   const int segments = grid.transverse;
   const NonlinearString string = building([&] {
-    return NonlinearString(physics, StringGrid{segments, grid.longitudinal ? grid.longitudinal
-                                                                           : segments});
+    return NonlinearString(physics,
+                           StringGrid{segments, grid.longitudinal ? grid.longitudinal : segments});
   });
   const int cells = string.grid().longitudinal;
   const Probe probeIndex{

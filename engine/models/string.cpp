@@ -64,8 +64,8 @@ NonlinearString::NonlinearString(const StringPhysics& p, StringGrid grid)
     throw std::invalid_argument("segments = " + std::to_string(grid.transverse) + ": must be >= 2");
   if (grid.longitudinal < 1 || grid.transverse % grid.longitudinal != 0)
     throw std::invalid_argument("longitudinal segments = " + std::to_string(grid.longitudinal) +
-                                ": must be >= 1 and divide the " +
-                                std::to_string(grid.transverse) + " transverse segments");
+                                ": must be >= 1 and divide the " + std::to_string(grid.transverse) +
+                                " transverse segments");
   ratio_ = grid.transverse / grid.longitudinal;
   h_ = p.length / grid.transverse;
   hv_ = p.length / grid.longitudinal;
@@ -236,8 +236,8 @@ void paddedTransverse(const double* u, Eigen::Index m, double* up) {
 // Σ (s_l − 1) and sets Σ 1/s_l, and ζ_l/s_l into `zetaOverS`; s_l = sqrt((1 + η)² + ζ_l²).
 // s − 1 = (2η + η² + ζ²)/(s + 1) has no cancellation at small strain, and one division serves
 // both quotients: t = 1/(s (s + 1)).
-[[gnu::always_inline]] inline double cellStretch(const double* up, double invH, double eta, int r, double* zetaOverS,
-                          double& sumInverse) {
+[[gnu::always_inline]] inline double cellStretch(const double* up, double invH, double eta, int r,
+                                                 double* zetaOverS, double& sumInverse) {
   const double a = (1.0 + eta) * (1.0 + eta), b = 2.0 * eta + eta * eta;
   double excess = 0.0, inverse = 0.0;
 #pragma omp simd reduction(+ : excess, inverse)
@@ -324,8 +324,8 @@ int gridSegments(const StringPhysics& p, GridRule rule, double k, double sigma1,
       rule == GridRule::longitudinal ? "h >= sqrt(E/rho) k" : "stiff-string bound (44)");
 }
 
-StringGrid stringGrid(const StringPhysics& p, GridRule rule, double k, double sigma1,
-                      double factor, double tensionMargin) {
+StringGrid stringGrid(const StringPhysics& p, GridRule rule, double k, double sigma1, double factor,
+                      double tensionMargin) {
   if (rule != GridRule::twoGrid) {
     const int m = gridSegments(p, rule, k, sigma1, factor);
     return {m, m};

@@ -1,6 +1,7 @@
 // The geometrically exact stiff string of BDZ §4.2: transverse u and longitudinal v on uniform
 // grids with fixed ends, split as (65) with bending stiffness EI ∂x⁴u added to K. v may live on a
-// coarser grid nested in u's (SCHEMES §3b), so that the longitudinal wave is resolved at audio rate.
+// coarser grid nested in u's (SCHEMES §3b), so that the longitudinal wave is resolved at audio
+// rate.
 #pragma once
 
 #include <algorithm>
@@ -109,9 +110,9 @@ constexpr const char* gridRuleName(GridRule rule) {
                                         : "longitudinal";
 }
 
-// The smallest h the rule allows (u's for twoGrid): transverse h² = (c²k² + 4σ1k + sqrt((c²k² + 4σ1k)² + 16κ²k²))/2
-// with c² = T0/ρA, κ² = EI/ρA (the continuous form of maxStableStep, so slightly conservative);
-// longitudinal h = max(sqrt(E/ρ) k, the transverse h).
+// The smallest h the rule allows (u's for twoGrid): transverse h² = (c²k² + 4σ1k + sqrt((c²k² +
+// 4σ1k)² + 16κ²k²))/2 with c² = T0/ρA, κ² = EI/ρA (the continuous form of maxStableStep, so
+// slightly conservative); longitudinal h = max(sqrt(E/ρ) k, the transverse h).
 double minimalSpacing(const StringPhysics& physics, GridRule rule, double k, double sigma1);
 // M = floor(L / (factor · h_min)) segments, at least 2. Throws std::invalid_argument if factor < 1
 // or the string is too short for two segments.

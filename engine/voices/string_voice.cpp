@@ -69,14 +69,14 @@ double gaugeShift(const StringPatch& patch, const NonlinearString& string, doubl
   }
   const double epsilon = patch.epsilon.value_or(0.0);
   const double most = kUnresolvedEpsilonShare * strike;
-  require(epsilon >= 0.0 && epsilon <= most, "epsilon_j", epsilon,
-          "between 0 and " + formatApprox(most, 3) +
-              " J on this grid: its longitudinal Courant number c_L k/h = " +
-              formatApprox(courant, 3) +
-              " exceeds 1, and a larger gauge shift lets ψ drift from sqrt(2(V'+ε)) until the "
-              "output is noise (at most a hundredth of the hardest strike's energy ½ M_H v_max² "
-              "= " +
-              formatApprox(strike, 3) + " J; grid_rule \"two-grid\" accepts any ε)");
+  require(
+      epsilon >= 0.0 && epsilon <= most, "epsilon_j", epsilon,
+      "between 0 and " + formatApprox(most, 3) +
+          " J on this grid: its longitudinal Courant number c_L k/h = " + formatApprox(courant, 3) +
+          " exceeds 1, and a larger gauge shift lets ψ drift from sqrt(2(V'+ε)) until the "
+          "output is noise (at most a hundredth of the hardest strike's energy ½ M_H v_max² "
+          "= " +
+          formatApprox(strike, 3) + " J; grid_rule \"two-grid\" accepts any ε)");
   return epsilon;
 }
 

@@ -25,7 +25,7 @@ struct StringPatch {
   GridRule grid = GridRule::twoGrid;
   double gridFactor = 1.0;
   double tensionMargin = 1.5;  // two grids: u's grid sized for this multiple of T0 (SCHEMES §3b)
-  int oversampling = 1;  // 1, 2, 4, 8, 16, 32 or 64
+  int oversampling = 1;        // 1, 2, 4, 8, 16, 32 or 64
   // Gauge shift ε, J; none: kEpsilonShare of the hardest strike's energy ½ M_H v_max² where v's
   // grid resolves the longitudinal wave, 0 where it does not (docs/string-grids.md).
   std::optional<double> epsilon;
@@ -75,7 +75,7 @@ class StringVoice {
   void process(std::span<float> left, std::span<float> right) noexcept;
 
   bool active() const { return active_; }
-  double energy() const;  // the scheme's H^{n+½} (ε excluded), J
+  double energy() const;                               // the scheme's H^{n+½} (ε excluded), J
   double injectedEnergy() const { return injected_; }  // by the strikes and the bend's retensioning
   // Taken out by the back-check (the hammer's kinetic energy and its ψ residual). The string's
   // losses are not tallied on the audio path; with them off, energy() + removedEnergy() stays

@@ -42,9 +42,9 @@ class PlayCli : public ::testing::Test {
 TEST_F(PlayCli, RefusesABadSetBeforeOpeningAnyDevice) {
   const std::string c3 = "--preset " + preset("paper-c3-string");
   for (const auto& [args, mention] :
-       {std::pair<std::string, std::string>{
-            c3 + " --set scheme.oversampling=3",
-            "paper-c3-string.toml: --set scheme.oversampling=3: expected one of 1, 2, 4, 8, 16, 32, 64"},
+       {std::pair<std::string, std::string>{c3 + " --set scheme.oversampling=3",
+                                            "paper-c3-string.toml: --set scheme.oversampling=3: "
+                                            "expected one of 1, 2, 4, 8, 16, 32, 64"},
         {c3 + " --set scheme.oversampeling=16", "did you mean scheme.oversampling?"},
         {c3 + " --set foo", "--set foo: expected NAME=VALUE"}}) {
     const CommandResult r = play(args);

@@ -46,8 +46,8 @@ Eigen::MatrixXd matrixOf(const NonlinearString& s, auto apply) {
 // a relative 1e-6 against central differences leaves room for O(δ²) and for roundoff ~ 1e-16 V'/δ.
 // On the single grid of (65), on nested grids of 5 and 8 fine segments per cell, and on one cell.
 TEST(NonlinearString, GradientIsTheDerivativeOfTheSplitPotential) {
-  for (const StringGrid grid : {StringGrid{40, 40}, StringGrid{40, 8}, StringGrid{40, 5},
-                                StringGrid{40, 1}}) {
+  for (const StringGrid grid :
+       {StringGrid{40, 40}, StringGrid{40, 8}, StringGrid{40, 5}, StringGrid{40, 1}}) {
     const NonlinearString string(c3(), grid);
     const Eigen::Index n = string.size(), nu = string.transverseSize();
     Vector grad(n);
@@ -56,10 +56,10 @@ TEST(NonlinearString, GradientIsTheDerivativeOfTheSplitPotential) {
       q.tail(n - nu) *= 1e-3;
       const double v = string.splitGradient(q, grad);
       EXPECT_DOUBLE_EQ(v, string.splitPotential(q));
-      testing::expectGradientIsDerivative(
-          [&](const Vector& x) { return string.splitPotential(x); }, grad, q,
-          [&](Eigen::Index j) { return j < nu ? 1e-7 : 1e-10; }, 1e-6,
-          1e-9 * grad.cwiseAbs().maxCoeff());
+      testing::expectGradientIsDerivative([&](const Vector& x) { return string.splitPotential(x); },
+                                          grad, q,
+                                          [&](Eigen::Index j) { return j < nu ? 1e-7 : 1e-10; },
+                                          1e-6, 1e-9 * grad.cwiseAbs().maxCoeff());
     }
   }
 }
@@ -80,7 +80,8 @@ TEST(NonlinearString, TwoGridPotentialAveragesTheStrainOverEachCell) {
     qn[mu - 1 + cell - 1] = stretch * (cell % 2);
   for (int j = 1; j < mu; ++j)  // the same v, linear in each cell, on the fine grid
     qs[mu - 1 + j - 1] = stretch * (j / r % 2 == 0 ? double(j % r) / r : 1.0 - double(j % r) / r);
-  EXPECT_NEAR(nested.splitPotential(qn), single.splitPotential(qs), 1e-12 * single.splitPotential(qs));
+  EXPECT_NEAR(nested.splitPotential(qn), single.splitPotential(qs),
+              1e-12 * single.splitPotential(qs));
 }
 
 // Mv = 1 leaves no longitudinal unknown: V' = (EA − T0) L ε² / 2 with ε = (ℓ − L)/L, ℓ the discrete
@@ -131,8 +132,7 @@ TEST(NonlinearString, StiffnessHasTheClosedFormSpectrum) {
     EXPECT_LE((k - k.transpose()).cwiseAbs().maxCoeff(), 1e-12 * k.cwiseAbs().maxCoeff());
     // M⁻¹K eigenvalues (of the symmetric M^-½ K M^-½): the two families of the header.
     const Vector root = string.inverseMass().cwiseSqrt();
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(root.asDiagonal() * k *
-                                                       root.asDiagonal());
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(root.asDiagonal() * k * root.asDiagonal());
     std::vector<double> expected;
     for (int m = 1; m < grid.transverse; ++m) expected.push_back(string.transverseEigenvalue(m));
     for (int m = 1; m < grid.longitudinal; ++m)
@@ -159,16 +159,16 @@ TEST(NonlinearString, LossOperatorIsMinusRhoAhD2OfTheDifference) {
     EXPECT_LE((c * (a - b) - out).cwiseAbs().maxCoeff(), 1e-12 * out.cwiseAbs().maxCoeff());
     // M⁻¹C = −D2 on each grid: eigenvalues (4/h²) sin²(mπ/2M), the largest on u's grid.
     const Vector root = string.inverseMass().cwiseSqrt();
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(root.asDiagonal() * c *
-                                                       root.asDiagonal());
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(root.asDiagonal() * c * root.asDiagonal());
     EXPECT_GE(eig.eigenvalues().minCoeff(), 0.0);
     EXPECT_NEAR(eig.eigenvalues().maxCoeff(), string.lossOperatorEigenvalueMax(),
                 1e-9 * string.lossOperatorEigenvalueMax());
     // The smallest is v's first mode: the coarser grid's −D2 sits further below (π/L)².
     const double hv = string.longitudinalSpacing();
-    EXPECT_NEAR(eig.eigenvalues().minCoeff(),
-                4.0 / (hv * hv) * std::pow(std::sin(std::numbers::pi / (2.0 * grid.longitudinal)), 2),
-                1e-9 * string.lossOperatorEigenvalueMax())
+    EXPECT_NEAR(
+        eig.eigenvalues().minCoeff(),
+        4.0 / (hv * hv) * std::pow(std::sin(std::numbers::pi / (2.0 * grid.longitudinal)), 2),
+        1e-9 * string.lossOperatorEigenvalueMax())
         << grid.longitudinal;
   }
 }

@@ -83,8 +83,8 @@ TEST(StringPitch, TuningByLengthWorksToo) {
   const TunedString tuned =
       tuneString(c3(), TuneBy::length, GridRule::transverse, k, 0.0, 1.0, target);
   EXPECT_EQ(tuned.physics.tension, 759.0);
-  EXPECT_NEAR(cents(schemePartial(NonlinearString(tuned.physics, tuned.grid), k, 1), target),
-              0.0, 1e-6);
+  EXPECT_NEAR(cents(schemePartial(NonlinearString(tuned.physics, tuned.grid), k, 1), target), 0.0,
+              1e-6);
 }
 
 TEST(StringPitch, TuningRefusesTheImpossible) {

@@ -229,16 +229,17 @@ TEST_F(SimCli, StringWritesTheDocumentedCsv) {
   }
 }
 
-// The voices' two grids from the research CLI: the paper's C3 (no stiffness) at 48 kHz has 11 coarse
-// cells (floor(L / (1.05 c_L k))) and u's grid at 1.5 T0 rounded down to a multiple of them; the
-// comment line says both; a first-mode start at α = 10 (with a gauge shift, SCHEMES §3b) conserves
-// (41); the snapshot's v is linear between the coarse points; --segments fixes one grid, so it is
-// refused with the two.
+// The voices' two grids from the research CLI: the paper's C3 (no stiffness) at 48 kHz has 11
+// coarse cells (floor(L / (1.05 c_L k))) and u's grid at 1.5 T0 rounded down to a multiple of them;
+// the comment line says both; a first-mode start at α = 10 (with a gauge shift, SCHEMES §3b)
+// conserves (41); the snapshot's v is linear between the coarse points; --segments fixes one grid,
+// so it is refused with the two.
 TEST_F(SimCli, StringOnTwoGrids) {
   const std::string snaps = path("snaps.csv");
-  const CliResult r = run("string --grid two-grid --k 2.0833333333333333e-05 --alpha 10 --epsilon "
-                          "0.01 --duration 0.01 --every 48 --snapshots 0.005 --snapshot-out " +
-                          snaps + " --out " + csv());
+  const CliResult r =
+      run("string --grid two-grid --k 2.0833333333333333e-05 --alpha 10 --epsilon "
+          "0.01 --duration 0.01 --every 48 --snapshots 0.005 --snapshot-out " +
+          snaps + " --out " + csv());
   ASSERT_EQ(r.exitCode, 0) << r.err;
   std::istringstream text(slurp(csv()));
   std::string comment;

@@ -365,9 +365,9 @@ TEST(StringVoice, FullRangeBendSweepsKeepTheEnergyAccountAndNeverTripTheGuard) {
       voice.setBend(2.0 * (phase < 0.5 ? 4.0 * phase - 1.0 : 3.0 - 4.0 * phase));
       voice.process(l, r);
       if (!lossy)
-        worst = std::max(worst, std::abs(voice.energy() + voice.removedEnergy() -
-                                         voice.injectedEnergy()) /
-                                    voice.injectedEnergy());
+        worst = std::max(worst,
+                         std::abs(voice.energy() + voice.removedEnergy() - voice.injectedEnergy()) /
+                             voice.injectedEnergy());
     }
     EXPECT_EQ(voice.guardEvents(), 0) << (lossy ? "lossy" : "lossless");
     EXPECT_TRUE(voice.active());
