@@ -339,7 +339,13 @@ StringGrid stringGrid(const StringPhysics& p, GridRule rule, double k, double si
   const double cL = std::sqrt(p.young / p.density);
   const double coarse = std::floor(p.length / (kLongitudinalGridFactor * cL * k));
   const int mv = static_cast<int>(std::clamp(coarse, 1.0, static_cast<double>(fine)));
-  return {fine / mv * mv, mv};
+  // u's grid rounded down to a multiple of Mv, or, where that loses more (Mv <= fine < 2 Mv, a
+  // string whose c_L is under twice c_T), r = ceil(fine / Mv) with fewer, longer coarse cells:
+  // either keeps u within the bound and v's Courant number below 1/1.05.
+  const StringGrid down{fine / mv * mv, mv};
+  const int r = (fine + mv - 1) / mv;
+  const StringGrid up{fine / r * r, fine / r};
+  return up.transverse > down.transverse ? up : down;
 }
 
 }  // namespace hamiltone

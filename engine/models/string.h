@@ -126,8 +126,9 @@ constexpr double kLongitudinalGridFactor = 1.05;
 // The grids of `rule` (SCHEMES §3b for twoGrid). transverse and longitudinal: Mu = Mv =
 // gridSegments(). twoGrid: Mv = max(1, floor(L / (1.05 sqrt(E/ρ) k))); u's finest grid sized for
 // the design tension `tensionMargin`·T0 (stability needs T0, accuracy under tension modulation the
-// margin), coarsened by `factor`, then rounded down to a multiple r·Mv (Mv lowered to it when even
-// r = 1 does not fit). Throws std::invalid_argument like gridSegments(), or for a margin < 1.
+// margin), coarsened by `factor`, then rounded down to a multiple r·Mv (with fewer coarse cells
+// where that keeps more of u's grid). Throws std::invalid_argument like gridSegments(), or for a
+// margin < 1.
 StringGrid stringGrid(const StringPhysics& physics, GridRule rule, double k, double sigma1,
                       double factor, double tensionMargin);
 

@@ -267,6 +267,18 @@ TEST(StringGrids, TwoGridsAreNestedAndSizedForTheDesignTension) {
   treble.length = 0.9 * cL * k;  // 9.5 cm
   EXPECT_EQ(stringGrid(treble, GridRule::twoGrid, k, 0.0, 1.0, 1.5).longitudinal, 1);
   EXPECT_THROW(stringGrid(p, GridRule::twoGrid, k, 0.0, 1.0, 0.9), std::invalid_argument);
+  // A string whose longitudinal wave is under twice as fast as its transverse one (EA = 2.25 T0):
+  // rounding u's grid down to a multiple of Mv would halve it; fewer, longer cells keep it.
+  StringPhysics slack = p;
+  slack.young = 2.25 * p.tension / p.area;
+  StringPhysics slackDesign = slack;
+  slackDesign.tension *= 1.5;
+  const int slackFinest = gridSegments(slackDesign, GridRule::transverse, k, 0.0, 1.0);
+  const StringGrid kept = stringGrid(slack, GridRule::twoGrid, k, 0.0, 1.0, 1.5);
+  EXPECT_EQ(kept.transverse % kept.longitudinal, 0);
+  EXPECT_GE(kept.transverse, slackFinest - 1);
+  EXPECT_LE(std::sqrt(slack.young / slack.density) * k / (slack.length / kept.longitudinal),
+            1.0 / 1.05 + 1e-12);
 }
 
 TEST(NonlinearString, RefusesUnphysicalStrings) {
