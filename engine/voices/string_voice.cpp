@@ -257,12 +257,15 @@ void StringVoice::release() noexcept {
 void StringVoice::catchHammer() noexcept {
   const HammeredString& system = scheme_->system();
   const Eigen::Index w = system.hammerIndex();
-  // Parked, the hammer stays there until the next strike: a flag, not q[w] == kParkedAt, since the
-  // loss's (1 + σ0k)/(1 + σ0k) can move it by an ulp, which made the check catch it again every
-  // millisecond (two energy evaluations each time: 9 % of a grand-piano key's cost).
-  if (parked_) return;
+  // Parked, the hammer stays there until the next strike or until the string itself swings down
+  // onto it: a flag, not q[w] == kParkedAt, since the loss's (1 + σ0k)/(1 + σ0k) can move it by
+  // an ulp, which made the check catch it again every millisecond (two energy evaluations each
+  // time: 9 % of a grand-piano key's cost).
   const Vector& q = scheme_->q();
-  if (system.compression(q) > 0.0) {
+  const bool contact = system.compression(q) > 0.0;
+  if (parked_ && !contact) return;
+  if (contact) {
+    parked_ = false;
     struck_ = true;
     separatedSteps_ = 0;
     return;
