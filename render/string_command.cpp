@@ -93,9 +93,15 @@ CLI::App* addStringCommand(CLI::App& app, StringArguments& a) {
 
 namespace {
 
-// u at grid point `probe` of u's grid, v at point `probeV` of v's (−1: v has no interior point).
+// u at the grid point nearest the probe; v there too on a single grid, and on two grids v linear in
+// the coarse cell holding the probe's x (v = 0 at the ends), as the snapshots take it.
 struct Probe {
-  Eigen::Index u = 0, v = -1;
+  Eigen::Index u = 0;
+  Eigen::Index vLow = -1, vHigh = -1;  // indices into q, −1 at a fixed end
+  double weight = 0.0;                 // of vHigh
+  double v(const Vector& q) const {
+    return (vLow >= 0 ? (1.0 - weight) * q[vLow] : 0.0) + (vHigh >= 0 ? weight * q[vHigh] : 0.0);
+  }
 };
 
 template <class Scheme>
@@ -108,7 +114,7 @@ RunSummary simulate(Scheme& scheme, Probe probe, long steps, long every, std::FI
       [&](const Snapshotting<Scheme>& w, const Energy& e, std::FILE* f) {
         const Scheme& s = w.scheme();
         writeNumber(f, s.q()[probe.u]);
-        writeNumber(f, probe.v >= 0 ? s.q()[probe.v] : 0.0);
+        writeNumber(f, probe.v(s.q()));
         writeNumber(f, e.total());
         if constexpr (requires { s.psi(); })
           writeNumber(f, s.psi());
@@ -194,11 +200,18 @@ int runStringCommand(const StringArguments& a) {
                            StringGrid{segments, grid.longitudinal ? grid.longitudinal : segments});
   });
   const int cells = string.grid().longitudinal;
-  const Probe probeIndex{
-      std::clamp<Eigen::Index>(std::lround(probe * segments) - 1, 0, segments - 2),
-      cells < 2 ? -1
-                : string.transverseSize() +
-                      std::clamp<Eigen::Index>(std::lround(probe * cells) - 1, 0, cells - 2)};
+  Probe probeIndex;
+  probeIndex.u = std::clamp<Eigen::Index>(std::lround(probe * segments) - 1, 0, segments - 2);
+  if (cells == segments) {
+    probeIndex.vLow = probeIndex.u + string.transverseSize();
+  } else {  // coarse points J and J + 1 around x = probe L, point J at q[offset + J − 1]
+    const double at = probe * cells;
+    const Eigen::Index cell = std::min<Eigen::Index>(static_cast<Eigen::Index>(at), cells - 1);
+    const Eigen::Index offset = string.transverseSize() - 1;
+    probeIndex.weight = at - static_cast<double>(cell);
+    probeIndex.vLow = cell == 0 ? -1 : offset + cell;
+    probeIndex.vHigh = cell + 1 == cells ? -1 : offset + cell + 1;
+  }
   const StepParameters params{.k = k, .sigma0 = sigma0, .sigma1 = sigma1, .epsilon = epsilon};
 
   if (!wanted.empty())
