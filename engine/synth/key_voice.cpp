@@ -57,13 +57,14 @@ void KeyVoice::strikeNow(double velocity) noexcept {
   if (plate_) plate_->noteOn(velocity);
 }
 
-void KeyVoice::release() noexcept {
+void KeyVoice::release(double damperScale) noexcept {
   if (pending()) {
     releasePending_ = true;
+    damperScale_ = damperScale;
     return;
   }
-  for (StringVoice& s : strings_) s.release();
-  if (plate_) plate_->release();
+  for (StringVoice& s : strings_) s.release(damperScale);
+  if (plate_) plate_->release(damperScale);
 }
 
 void KeyVoice::fadeOut() noexcept {
@@ -99,7 +100,7 @@ void KeyVoice::process(std::span<float> left, std::span<float> right, double gai
     if (!fading() && pending()) {  // the fade is over (or its voices fell silent): strike
       strikeNow(pendingVelocity_);
       pendingVelocity_ = -1.0;
-      if (releasePending_) release();
+      if (releasePending_) release(damperScale_);
       releasePending_ = false;
     }
     const bool wasFading = fading();

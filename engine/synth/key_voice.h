@@ -22,7 +22,9 @@ class KeyVoice {
   // 0 … 1. A sounding key is struck again where it is; a fading one is struck once its fade
   // ends, from rest (the note-on is pending until then).
   void strike(double velocity, long order) noexcept;
-  void release() noexcept;  // the damper falls (on a pending strike: right after it)
+  // The damper falls (on a pending strike: right after it), its T60 the patch's times
+  // `damperScale`.
+  void release(double damperScale = 1.0) noexcept;
   void fadeOut() noexcept;  // stolen or silenced: fades over kFadeS, then frees itself
   void setBend(double semitones) noexcept;
 
@@ -55,6 +57,7 @@ class KeyVoice {
   int fadeSamples_ = 1, fadeLeft_ = 0;
   double pendingVelocity_ = -1.0;  // < 0: none
   bool releasePending_ = false;    // released before its pending strike
+  double damperScale_ = 1.0;       // the pending release's
   long order_ = 0;
   double envelope_ = 0.0, envelopeDecay_ = 0.0;
   long sinceStrike_ = 0, attackSamples_ = 0;

@@ -78,6 +78,10 @@ void Synth::setPolyphony(int voices) noexcept {
   }
 }
 
+void Synth::setDamperScale(double scale) noexcept {
+  damperScale_ = std::isnan(scale) ? 1.0 : std::clamp(scale, 0.1, 10.0);
+}
+
 int Synth::polyphony() const {
   return polyphonyOverride_ > 0 ? polyphonyOverride_ : instruments_[program_].polyphony;
 }
@@ -141,7 +145,7 @@ void Synth::noteOff(int note) noexcept {
   if (sustain_)
     voice->sustained = true;
   else
-    voice->release();
+    voice->release(damperScale_);
 }
 
 void Synth::setSustain(bool down) noexcept {
@@ -152,7 +156,7 @@ void Synth::setSustain(bool down) noexcept {
     for (KeyVoice& v : keys)
       if (v.sustained) {
         v.sustained = false;
-        v.release();
+        v.release(damperScale_);
       }
 }
 

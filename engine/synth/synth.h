@@ -50,6 +50,9 @@ class Synth {
   // The limit on sounding keys; 0 restores the instrument's own polyphony. Keys beyond a lowered
   // limit fade out at once (released keys first, the oldest of them; then the quietest).
   void setPolyphony(int voices) noexcept;
+  // How long the dampers take, as a multiple of each key's damper_t60_s (1: the preset's), clamped
+  // to 0.1 … 10: a performance control, like the pedal, for the keys released from now on.
+  void setDamperScale(double scale) noexcept;
   int polyphony() const;
   int activeVoices() const;
   int program() const { return program_; }
@@ -79,6 +82,7 @@ class Synth {
   int downProgram_[128];  // which instrument's voice a held note struck (−1: none)
   bool sustain_ = false;
   double bend_ = 0.0;  // −1 … 1 of the range
+  double damperScale_ = 1.0;
   long strikes_ = 0;
 };
 

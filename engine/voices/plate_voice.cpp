@@ -176,9 +176,9 @@ double PlateVoice::pulseOverStep() const noexcept {
   return pulseForce_ * 0.5 * ((b - a) - (std::sin(w * b) - std::sin(w * a)) / w) / k_;
 }
 
-void PlateVoice::release() noexcept {
+void PlateVoice::release(double damperScale) noexcept {
   released_ = true;
-  scheme_->setSigma0(loss_.sigma0 + kLn1000 / patch_.damperT60);
+  scheme_->setSigma0(releasedSigma0(loss_.sigma0, patch_.damperT60, damperScale, k_));
 }
 
 // Velocity (q^{n+1} − q^n)/k or displacement q^n, bilinear between the grid points around (x, y).

@@ -51,7 +51,8 @@ class PlateVoice {
   void reset() noexcept;
 
   void noteOn(double velocity) noexcept;  // 0 … 1: a harder strike is louder and shorter
-  void release() noexcept;
+  // The damper falls, its T60 damper_t60_s times `damperScale` (releasedSigma0).
+  void release(double damperScale = 1.0) noexcept;
 
   // Writes the next left.size() samples (and min(left, right) of right). Never allocates.
   void process(std::span<float> left, std::span<float> right) noexcept;

@@ -246,9 +246,9 @@ void StringVoice::noteOn(double velocity) noexcept {
   active_ = true;
 }
 
-void StringVoice::release() noexcept {
+void StringVoice::release(double damperScale) noexcept {
   released_ = true;
-  scheme_->setSigma0(loss_.sigma0 + kLn1000 / patch_.damperT60);
+  scheme_->setSigma0(releasedSigma0(loss_.sigma0, patch_.damperT60, damperScale, k_));
 }
 
 // The back-check: once the hammer has struck and left the string (escapement: no force drives

@@ -1,5 +1,5 @@
-// What every voice does around a block: silence a span pair, and tell when a released note has
-// gone quiet — shared by the string and the plate voices.
+// What every voice does around a block: silence a span pair, damp a released note, and tell when
+// it has gone quiet — shared by the string and the plate voices.
 #pragma once
 
 #include <algorithm>
@@ -22,6 +22,15 @@ inline void silence(std::span<float> left, std::span<float> right, size_t rightC
 // longitudinal stretch held by ψ, or a period-2 longitudinal oscillation (q^{n+1} = q^{n−1},
 // which the centred σ0 of the damper cannot touch), measured at C3 at −58 dB of the strike's
 // energy with a 0.3 s damper.
+// The loss σ0 of a released voice: its own σ0 plus ln(1000) / T60 of its damper, the damper's
+// T60 times `scale` (Synth::setDamperScale). The scheme needs σ0 k < 1; prepare() checked the
+// preset's damper against it, so a shorter scaled one is held at the larger of that and 0.9 / k.
+inline double releasedSigma0(double sigma0, double damperT60, double scale, double k) noexcept {
+  constexpr double kLn1000 = 6.907755278982137;  // T60 = ln(1000) / σ
+  const double preset = sigma0 + kLn1000 / damperT60;
+  return std::min(sigma0 + kLn1000 / (damperT60 * scale), std::max(preset, 0.9 / k));
+}
+
 class QuietDetector {
  public:
   static constexpr double kLevel = 1e-4;    // of the loudest: −80 dB

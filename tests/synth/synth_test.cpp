@@ -73,6 +73,20 @@ TEST(Synth, SustainHoldsReleasedNotesUntilThePedalLifts) {
   EXPECT_FALSE(synth.voice(0, 49)->sounding());
 }
 
+// The damper scale reaches the keys released after it is set, through the pedal too: the test
+// keys' damper (T60 0.25 s) frees a key within 1 s; four times as long, it still sounds then.
+TEST(Synth, DamperScaleLengthensTheDecayOfReleasedKeys) {
+  Synth synth = prepared({pianoKeys(48, 50)});
+  synth.setDamperScale(4.0);
+  render(synth, {{0.0, on(48)}, {0.1, off(48)}}, 1.1, 256);
+  EXPECT_TRUE(synth.voice(0, 48)->sounding());
+  render(synth, {{0.0, cc(64, 127)}, {0.0, on(49)}, {0.1, off(49)}, {0.2, cc(64, 0)}}, 1.2, 256);
+  EXPECT_TRUE(synth.voice(0, 49)->sounding());
+  synth.setDamperScale(1.0);
+  render(synth, {{0.0, on(50)}, {0.1, off(50)}}, 1.1, 256);
+  EXPECT_FALSE(synth.voice(0, 50)->sounding());
+}
+
 TEST(Synth, RestrikingASoundingKeyReexcitesTheSameVoice) {
   Synth synth = prepared({pianoKeys(48, 48)});
   render(synth, {{0.0, on(48, 60)}}, 0.2, 64);

@@ -173,6 +173,21 @@ TEST(StringVoice, DamperShortensTheDecayToItsT60) {
   EXPECT_NEAR(voice.injectedEnergy(), 0.5 * HammerFelt{}.mass * speed * speed, 1e-9);
 }
 
+// A scaled damper (the plugin's damper knob) decays in the patch's T60 times the scale.
+TEST(StringVoice, DamperScaleMultipliesTheT60) {
+  StringPatch patch = piano(48);
+  patch.t60Low = patch.t60High = INFINITY;
+  patch.damperT60 = 0.3;
+  for (double scale : {0.5, 2.0}) {
+    StringVoice voice;
+    voice.prepare(patch, 48, 48000.0);
+    voice.noteOn(0.5);
+    play(voice, 0.05, 48000.0, [] {});
+    voice.release(scale);
+    EXPECT_NEAR(measuredT60(voice, 0.0, 0.4 * scale), 0.3 * scale, 0.05 * 0.3 * scale);
+  }
+}
+
 // A gauge shift of 1e30 J drowns the energy (41) in roundoff (the ulp of 1e30 is ~1e14 J):
 // exactly the runaway the guard exists for. The output is silent and the voice reset.
 // No patch the voice accepts runs away (an unresolved grid refuses a large ε, GaugeShift… below),
