@@ -21,6 +21,7 @@
 #include "preset_arguments.h"
 #include "recorder.h"
 #include "usage_error.h"
+#include "version.h"
 
 namespace hamiltone::app {
 namespace {
@@ -221,6 +222,7 @@ int main(int argc, char** argv) {
   namespace cli = hamiltone::cli;
   CLI::App app{"hamiltone-play: plays Hamiltone's physical models live from MIDI."};
   PlayArguments a;
+  app.set_version_flag("--version", std::string("hamiltone-play ") + cli::versionText());
   app.add_option("--preset", a.presets,
                  "instrument preset (TOML); repeat it to load several, chosen by MIDI program "
                  "change (0 = the first). Default: " HAMILTONE_DEFAULT_PRESET)
@@ -252,7 +254,7 @@ int main(int argc, char** argv) {
       "playing (the recording is complete up to then).");
   try {
     app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
+  } catch (const CLI::Success& e) {  // --help, --version
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::fprintf(stderr, "hamiltone-play: %s (see hamiltone-play --help)\n", e.what());

@@ -18,6 +18,7 @@
 #include "progress_bar.h"
 #include "usage_error.h"
 #include "util/format_number.h"
+#include "version.h"
 
 namespace hamiltone::cli {
 namespace {
@@ -135,6 +136,7 @@ int main(int argc, char** argv) {
       "hamiltone-render: plays a MIDI file or a list of notes on Hamiltone's physical models and "
       "writes a stereo WAV file."};
   RenderArguments a;
+  app.set_version_flag("--version", std::string("hamiltone-render ") + versionText());
   app.add_option("--preset", a.presets,
                  "instrument preset (TOML); repeat it to load several, chosen by MIDI program "
                  "change (0 = the first). Default: " HAMILTONE_DEFAULT_PRESET)
@@ -167,7 +169,7 @@ int main(int argc, char** argv) {
 
   try {
     app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
+  } catch (const CLI::Success& e) {  // --help, --version
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::fprintf(stderr, "hamiltone-render: %s (see hamiltone-render --help)\n", e.what());

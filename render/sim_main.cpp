@@ -4,12 +4,14 @@
 #include <CLI/Formatter.hpp>
 #include <cstdio>
 #include <exception>
+#include <string>
 
 #include "fpu_command.h"
 #include "particle_command.h"
 #include "plate_command.h"
 #include "string_command.h"
 #include "usage_error.h"
+#include "version.h"
 #include "wave_command.h"
 #include "wave_inhomogeneous_command.h"
 
@@ -19,6 +21,7 @@ int main(int argc, char** argv) {
       "hamiltone-sim: runs the test problems of Bilbao, Ducceschi & Zama (2022) and "
       "Marazzato et al. (2020) on Hamiltone's schemes and writes CSV."};
   app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("hamiltone-sim ") + versionText());
   FpuArguments fpu;
   CLI::App* fpuCommand = addFpuCommand(app, fpu);
   StringArguments string;
@@ -34,9 +37,7 @@ int main(int argc, char** argv) {
 
   try {
     app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForAllHelp& e) {
+  } catch (const CLI::Success& e) {  // --help, --help-all, --version
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::fprintf(stderr, "hamiltone-sim: %s (see hamiltone-sim --help)\n", e.what());
