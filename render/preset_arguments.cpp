@@ -2,6 +2,7 @@
 // this reads them off the command line and gathers every preset's errors into one UsageError.
 #include "preset_arguments.h"
 
+#include "preset_search.h"
 #include "presets/parameters.h"
 #include "usage_error.h"
 
@@ -46,7 +47,7 @@ std::vector<Instrument> loadPresets(const std::vector<std::string>& files,
   std::string errors;
   for (const std::string& file : files) {
     try {
-      instruments.push_back(loadPreset(file, options));
+      instruments.push_back(loadPreset(resolvePreset(file), options));
     } catch (const PresetError& e) {
       errors += std::string(errors.empty() ? "" : "\n") + e.what();
     }

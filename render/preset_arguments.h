@@ -16,8 +16,9 @@ void addSetOption(CLI::App* app, std::vector<std::string>& sets);
 // The --set arguments, in order; UsageError for the first without NAME=, saying what is valid.
 std::vector<PresetOverride> parseSets(const std::vector<std::string>& sets);
 
-// Every file loaded with every --set over it (PresetOptions::overrides); UsageError "bad preset:"
-// with every error line of every file, or of a malformed --set.
+// Every file (or preset name, resolvePreset) loaded with every --set over it
+// (PresetOptions::overrides); UsageError "bad preset:" with every error line of every file, or of
+// a malformed --set, or for the first name that names no preset.
 std::vector<Instrument> loadPresets(const std::vector<std::string>& files,
                                     const std::vector<std::string>& sets);
 

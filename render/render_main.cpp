@@ -14,6 +14,7 @@
 #include "number_arguments.h"
 #include "performance.h"
 #include "preset_arguments.h"
+#include "preset_search.h"
 #include "presets/parameters.h"
 #include "progress_bar.h"
 #include "usage_error.h"
@@ -47,9 +48,12 @@ int run(const RenderArguments& a) {
   if (a.midi.empty() == a.notes.empty())
     throw UsageError("give exactly one of --midi FILE or --notes LIST");
   if (a.out.empty()) throw UsageError("-o FILE: the WAV file to write is required");
+  const std::vector<std::string> presets =
+      a.presets.empty() ? std::vector<std::string>{HAMILTONE_DEFAULT_PRESET} : a.presets;
   std::vector<InputFile> inputs{{"--midi", a.midi}};
-  for (const std::string& file : a.presets) inputs.push_back({"--preset", file});
-  if (a.presets.empty()) inputs.push_back({"--preset (the default)", HAMILTONE_DEFAULT_PRESET});
+  for (const std::string& preset : presets)
+    inputs.push_back({a.presets.empty() ? "--preset (the default)" : "--preset",
+                      resolvePreset(preset).string()});
   refuseInputAsOutput("-o", a.out, inputs);
   const double rate =
       static_cast<double>(parseInteger("--sample-rate", a.sampleRate, 8000, 384000));
@@ -60,8 +64,7 @@ int run(const RenderArguments& a) {
       a.voices.empty() ? 0 : static_cast<int>(parseInteger("--voices", a.voices, 1, 128));
 
   // Everything is read and checked before the output file is created.
-  std::vector<Instrument> instruments = loadPresets(
-      a.presets.empty() ? std::vector<std::string>{HAMILTONE_DEFAULT_PRESET} : a.presets, a.sets);
+  std::vector<Instrument> instruments = loadPresets(presets, a.sets);
   std::vector<TimedMessage> messages;
   double end = 0.0;
   if (!a.midi.empty()) {
@@ -138,9 +141,11 @@ int main(int argc, char** argv) {
   RenderArguments a;
   app.set_version_flag("--version", std::string("hamiltone-render ") + versionText());
   app.add_option("--preset", a.presets,
-                 "instrument preset (TOML); repeat it to load several, chosen by MIDI program "
-                 "change (0 = the first). Default: " HAMILTONE_DEFAULT_PRESET)
-      ->type_name("FILE");
+                 "instrument preset: a TOML file, or the name of one in the preset directories "
+                 "($XDG_DATA_HOME, $XDG_DATA_DIRS, the install's share/: hamiltone/presets/); "
+                 "repeat it to load several, chosen by MIDI program change (0 = the first). "
+                 "Default: " HAMILTONE_DEFAULT_PRESET)
+      ->type_name("FILE|NAME");
   addSetOption(&app, a.sets);
   app.add_option("--midi", a.midi, "Standard MIDI File (format 0 or 1) to play")->type_name("FILE");
   app.add_option("--notes", a.notes,
