@@ -1,4 +1,5 @@
-// hamiltone-render: plays a MIDI file or a --notes list on presets and writes a WAV file.
+// hamiltone-render: plays a MIDI file or a --notes list on presets and writes a WAV, FLAC or Ogg
+// Vorbis file.
 #include <CLI/App.hpp>
 #include <CLI/Config.hpp>
 #include <CLI/Formatter.hpp>
@@ -47,7 +48,7 @@ int run(const RenderArguments& a) {
   }
   if (a.midi.empty() == a.notes.empty())
     throw UsageError("give exactly one of --midi FILE or --notes LIST");
-  if (a.out.empty()) throw UsageError("-o FILE: the WAV file to write is required");
+  if (a.out.empty()) throw UsageError("-o FILE: the sound file to write is required");
   const std::vector<std::string> presets =
       a.presets.empty() ? std::vector<std::string>{HAMILTONE_DEFAULT_PRESET} : a.presets;
   std::vector<InputFile> inputs{{"--midi", a.midi}};
@@ -55,6 +56,11 @@ int run(const RenderArguments& a) {
     inputs.push_back({a.presets.empty() ? "--preset (the default)" : "--preset",
                       resolvePreset(preset).string()});
   refuseInputAsOutput("-o", a.out, inputs);
+  const FileType type = fileTypeOf(a.out, "-o");
+  if (type == FileType::flac && a.format == "float32")
+    throw UsageError(
+        "--format float32: FLAC holds integer samples; use pcm16 or pcm24, or -o "
+        "a .wav file");
   const double rate =
       static_cast<double>(parseInteger("--sample-rate", a.sampleRate, 8000, 384000));
   const double tail = parseReal("--tail", a.tail, Range::nonNegative, " seconds");
@@ -84,7 +90,7 @@ int run(const RenderArguments& a) {
     throw UsageError((a.midi.empty() ? "--notes" : "--midi " + a.midi) + ": lasts " +
                      formatNumber(end) + " s: at most 24 h can be rendered");
   const double bytesPerSample = a.format == "pcm16" ? 2.0 : a.format == "pcm24" ? 3.0 : 4.0;
-  if ((end + tail) * rate * 2.0 * bytesPerSample > kMaxWavBytes)
+  if (type == FileType::wav && (end + tail) * rate * 2.0 * bytesPerSample > kMaxWavBytes)
     throw UsageError("the render would be " + formatNumber(end + tail) + " s at " + a.sampleRate +
                      " Hz in " + a.format +
                      ": more than the 4 GiB a WAV file can hold; use a lower rate or pcm16");
@@ -113,7 +119,7 @@ int run(const RenderArguments& a) {
   }
   synth.setPolyphony(voices);
 
-  WavWriter out(a.out, "-o", static_cast<int>(rate), 2, sampleFormat(a.format));
+  WavWriter out(a.out, "-o", static_cast<int>(rate), 2, sampleFormat(a.format), type);
   const double seconds = end + tail;
   ProgressBar bar(seconds, progressWanted(a.quiet));
   const RenderStats stats = renderPerformance(synth, messages, seconds, block, rate, out,
@@ -137,7 +143,7 @@ int main(int argc, char** argv) {
   using namespace hamiltone::cli;
   CLI::App app{
       "hamiltone-render: plays a MIDI file or a list of notes on Hamiltone's physical models and "
-      "writes a stereo WAV file."};
+      "writes a stereo WAV, FLAC or Ogg Vorbis file."};
   RenderArguments a;
   app.set_version_flag("--version", std::string("hamiltone-render ") + versionText());
   app.add_option("--preset", a.presets,
@@ -154,10 +160,11 @@ int main(int argc, char** argv) {
                  "DURATION 1 s by default)")
       ->type_name("LIST");
   app.add_option("-o,--out", a.out,
-                 "WAV file to write (replaced whole, or untouched on error); not an input file")
+                 "sound file to write, its format chosen by the extension: .wav, .flac or .ogg "
+                 "(Ogg Vorbis); replaced whole, or untouched on error; not an input file")
       ->type_name("FILE");
   addNumberOption(&app, "--sample-rate", a.sampleRate, "HZ", "sample rate, 8000 … 384000");
-  app.add_option("--format", a.format, "sample format")
+  app.add_option("--format", a.format, "sample format of a WAV or FLAC file (FLAC: pcm16, pcm24)")
       ->check(CLI::IsMember({"pcm16", "pcm24", "float32"}))
       ->capture_default_str();
   addNumberOption(&app, "--tail", a.tail, "SECONDS", "rendered after the last event, 0 … 600");

@@ -6,9 +6,13 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <stdexcept>
+
+#include "usage_error.h"
 
 namespace hamiltone::cli {
 
@@ -32,6 +36,25 @@ int checkedChannels(int channels) {
   return channels;
 }
 
+int container(FileType type) {
+  switch (type) {
+    case FileType::wav:
+      return SF_FORMAT_WAV;
+    case FileType::flac:
+      return SF_FORMAT_FLAC;
+    case FileType::ogg:
+      return SF_FORMAT_OGG;
+  }
+  throw std::invalid_argument("WavWriter: unknown file type");
+}
+
+// Checked in the member initialisers, with the rate and the channels.
+FileType checkedType(FileType type, SampleFormat format) {
+  if (type == FileType::flac && format == SampleFormat::float32)
+    throw std::invalid_argument("FLAC holds integer samples: pcm16 or pcm24, not float32");
+  return type;
+}
+
 int subformat(SampleFormat format) {
   switch (format) {
     case SampleFormat::pcm16:
@@ -48,27 +71,42 @@ float sanitised(float x) { return std::isfinite(x) ? std::clamp(x, -1.0f, 1.0f) 
 
 }  // namespace
 
+FileType fileTypeOf(const std::string& path, const std::string& flag) {
+  std::string extension = std::filesystem::path(path).extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (extension == ".wav") return FileType::wav;
+  if (extension == ".flac") return FileType::flac;
+  if (extension == ".ogg") return FileType::ogg;
+  throw UsageError(
+      flag + " " + path + ": " +
+      (extension.empty() ? "no extension" : extension + " is not a format hamiltone can write") +
+      "; the extension chooses the format: .wav, .flac or .ogg (Ogg Vorbis)");
+}
+
 WavWriter::WavWriter(std::string path, const std::string& flag, int sampleRate, int channels,
-                     SampleFormat format)
+                     SampleFormat format, FileType type)
     : path_(std::move(path)),
       sampleRate_(checkedSampleRate(sampleRate)),
       channels_(checkedChannels(channels)),
+      type_(checkedType(type, format)),
       file_(path_, flag) {
   SF_INFO info{};
   info.samplerate = sampleRate_;
   info.channels = channels_;
-  info.format = SF_FORMAT_WAV | subformat(format);
+  info.format = container(type_) | (type_ == FileType::ogg ? SF_FORMAT_VORBIS : subformat(format));
   sound_ = sf_open_fd(fileno(file_.stream()), SFM_WRITE, &info, SF_FALSE);
   if (!sound_)
-    throw std::runtime_error("cannot write " + path_ + " as WAV: " + sf_strerror(nullptr));
+    throw std::runtime_error("cannot write " + path_ +
+                             ": libsndfile refuses the format: " + sf_strerror(nullptr));
   // With clipping on, libsndfile saturates +1.0 — it scales by 2^15 (2^23 for 24-bit), one
   // step past the largest code — instead of wrapping it to -1. (It then rounds down, 1.2.0
   // measured: an error below one step, where without clipping it rounds to nearest.)
-  if (format != SampleFormat::float32) sf_command(sound_, SFC_SET_CLIPPING, nullptr, SF_TRUE);
+  if (format != SampleFormat::float32 && type_ != FileType::ogg)
+    sf_command(sound_, SFC_SET_CLIPPING, nullptr, SF_TRUE);
   // A float file would get a PEAK chunk stamped with the time of writing, so two renders of the
   // same input would differ in those bytes. The peaks are known to be within ±1 (sanitised), so
   // the chunk says nothing worth a non-reproducible file. Must precede the first write.
-  if (format == SampleFormat::float32)
+  if (format == SampleFormat::float32 && type_ == FileType::wav)
     sf_command(sound_, SFC_SET_ADD_PEAK_CHUNK, nullptr, SF_FALSE);
   chunk_.resize(kChunkFrames * static_cast<std::size_t>(channels_));
 }
@@ -97,6 +135,10 @@ void WavWriter::write(const float* interleaved, std::size_t frames) {
 
 void WavWriter::commit() {
   if (!sound_) throw std::logic_error("WavWriter::commit twice: " + path_);
+  if (failed_ && type_ != FileType::wav)
+    throw std::runtime_error("writing " + path_ +
+                             " failed: a compressed file cannot be kept up to "
+                             "the error");
   if (failed_) {
     // Cut what a failed write left past the last whole frame: seeking the write position to
     // that frame puts the descriptor at the end of the data that is kept. libsndfile computes

@@ -1,5 +1,6 @@
-// A WAV file written through libsndfile that appears whole on commit() or not at all, and is the
-// same bytes for the same samples (no time stamp in any chunk).
+// A sound file written through libsndfile that appears whole on commit() or not at all: a WAV
+// (the same bytes for the same samples: no time stamp in any chunk), or a FLAC or Ogg Vorbis file
+// when the caller asks for one — hamiltone-render by -o's extension (fileTypeOf).
 #pragma once
 
 #include <sndfile.h>
@@ -12,16 +13,23 @@
 
 namespace hamiltone::cli {
 
-enum class SampleFormat { pcm16, pcm24, float32 };
+enum class SampleFormat { pcm16, pcm24, float32 };  // Ogg Vorbis, lossy, has none of its own
+
+enum class FileType { wav, flac, ogg };
+
+// The type the extension of `path` names, in any case: .wav, .flac, .ogg. UsageError naming `flag`,
+// the path and its extension, and listing the valid ones, for any other extension or none.
+FileType fileTypeOf(const std::string& path, const std::string& flag);
 
 class WavWriter {
  public:
   // Creates the temporary beside `path` now (see AtomicFile), so a bad path fails before any
   // rendering: UsageError naming `flag` for an empty path, a directory, a device or an
-  // unwritable directory; std::invalid_argument for a sample rate <= 0 or channels not 1 or 2;
-  // std::runtime_error naming the path if libsndfile refuses the format.
+  // unwritable directory; std::invalid_argument for a sample rate <= 0, channels not 1 or 2, or
+  // FLAC in float32 (FLAC holds integers); std::runtime_error naming the path if libsndfile
+  // refuses the format.
   WavWriter(std::string path, const std::string& flag, int sampleRate, int channels,
-            SampleFormat format);
+            SampleFormat format, FileType type = FileType::wav);
   ~WavWriter();  // closes and removes the temporary unless committed
   WavWriter(const WavWriter&) = delete;
   WavWriter& operator=(const WavWriter&) = delete;
@@ -34,8 +42,9 @@ class WavWriter {
   // written before the failure are kept, and framesWritten() counts them.
   void write(const float* interleaved, std::size_t frames);
   // Writes the header, closes and renames onto the path; throws std::runtime_error on an error.
-  // After a failed write() the file is cut to framesWritten() whole frames first, so what
-  // appears is a valid WAV of what was written before the failure.
+  // After a failed write() a WAV is cut to framesWritten() whole frames first, so what appears
+  // is a valid WAV of what was written before the failure; a compressed file cannot be cut, so
+  // then commit() throws and nothing appears.
   void commit();
 
   std::size_t framesWritten() const { return written_; }
@@ -47,6 +56,7 @@ class WavWriter {
  private:
   std::string path_;
   int sampleRate_, channels_;
+  FileType type_;
   AtomicFile file_;
   SNDFILE* sound_ = nullptr;  // writes through the temporary's descriptor
   std::vector<float> chunk_;  // sanitised samples on their way to libsndfile

@@ -12,6 +12,7 @@
 #include <numbers>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "support/riff_chunks.h"
@@ -162,6 +163,29 @@ TEST_F(RenderCli, RefusesBadInputAndWritesNothing) {
   const Result r = run(c3 + " --notes C3 -o /proc/hamiltone/out.wav");
   EXPECT_EQ(r.exitCode, 2) << r.err;
   EXPECT_NE(r.err.find("-o"), std::string::npos) << r.err;
+}
+
+// -o's extension chooses the format; another is refused naming it, before any work.
+TEST_F(RenderCli, TheOutputExtensionChoosesTheFormat) {
+  const std::string c3 = "--preset " + preset("paper-c3-string") + " --notes C3:100:0.2 --tail 0 ";
+  for (const auto& [name, type] :
+       {std::pair{"out.flac", SF_FORMAT_FLAC}, std::pair{"out.ogg", SF_FORMAT_OGG},
+        std::pair{"out.WAV", SF_FORMAT_WAV}}) {
+    const fs::path out = dir_ / name;
+    const Result r = run(c3 + "--quiet -o " + out.string());
+    ASSERT_EQ(r.exitCode, 0) << name << ": " << r.err;
+    EXPECT_EQ(read(out).info.format & SF_FORMAT_TYPEMASK, type) << name;
+  }
+  const Result mp3 = run(c3 + "-o " + (dir_ / "out.mp3").string());
+  EXPECT_EQ(mp3.exitCode, 2);
+  EXPECT_NE(mp3.err.find("out.mp3: .mp3 is not a format hamiltone can write; the extension "
+                         "chooses the format: .wav, .flac or .ogg"),
+            std::string::npos)
+      << mp3.err;
+  EXPECT_FALSE(fs::exists(dir_ / "out.mp3"));
+  const Result flacFloat = run(c3 + "--format float32 -o " + (dir_ / "f.flac").string());
+  EXPECT_EQ(flacFloat.exitCode, 2);
+  EXPECT_NE(flacFloat.err.find("FLAC holds integer samples"), std::string::npos) << flacFloat.err;
 }
 
 // --set over every preset, heard in the file: A4 of the grand piano tuned to a4_Hz = 432 (the
