@@ -13,6 +13,7 @@ packages=(
   # "libjack-dev | libjack-jackd2-dev": named, or apt takes the first, jackd1's, which removes
   # jackd2 (below) — and the next run's jackd2 removes these two.
   libjack-jackd2-dev librtaudio-dev librtmidi-dev
+  dpf-source          # plugin/: DPF (the DISTRHO Plugin Framework) and the CLAP headers
   libgtest-dev libgmock-dev  # tests/
   clang libclang-rt-14-dev   # tests/fuzz: libFuzzer targets for the MIDI reader and preset loader
   clang-22 libclang-rt-22-dev llvm-22  # tests/rtsan: RTSan test (bookworm-security; llvm-22 symbolises)
