@@ -15,6 +15,7 @@ packages=(
   libjack-jackd2-dev librtaudio-dev librtmidi-dev
   dpf-source          # plugin/: DPF (the DISTRHO Plugin Framework) and the CLAP headers
   libgtest-dev libgmock-dev  # tests/
+  lv2-dev sordi       # tests/plugin: lv2_validate and the sord_validate it runs
   clang libclang-rt-14-dev   # tests/fuzz: libFuzzer targets for the MIDI reader and preset loader
   clang-22 libclang-rt-22-dev llvm-22  # tests/rtsan: RTSan test (bookworm-security; llvm-22 symbolises)
   libbenchmark-dev    # bench/

@@ -1,0 +1,117 @@
+// The plugin's audio-thread part without a host: velocity curves, MIDI bytes on their frames (more
+// than fit one piece, past the block, sysex skipped), and the swap to a new synthesizer between
+// blocks — the old one faded out in 10 ms, nothing lost or doubled.
+#include "playing_synth.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <thread>
+#include <vector>
+
+namespace hamiltone::plugin {
+namespace {
+
+// A MIDI event as DPF hands it over: frame, size, bytes.
+struct Midi {
+  uint32_t frame, size;
+  uint8_t data[4];
+};
+
+constexpr double kRate = 48000.0;
+
+struct Block {
+  std::vector<float> left, right;
+  explicit Block(size_t frames) : left(frames), right(frames) {}
+  float peak(size_t from = 0, size_t to = SIZE_MAX) const {
+    to = std::min(to, left.size());
+    float p = 0.0f;
+    for (const std::vector<float>* channel : {&left, &right})
+      for (float x : std::span(*channel).subspan(from, to - from)) p = std::max(p, std::abs(x));
+    return p;
+  }
+};
+
+Block play(PlayingSynth& playing, size_t frames, const std::vector<Midi>& midi = {}) {
+  Block b(frames);
+  playing.process(std::span(b.left), std::span(b.right), std::span<const Midi>(midi));
+  return b;
+}
+
+TEST(CurvedVelocity, BendsTheVelocityAndNeverMakesANoteOff) {
+  EXPECT_EQ(curvedVelocity(64, 1.0), 64);
+  EXPECT_EQ(curvedVelocity(127, 2.0), 127);
+  EXPECT_EQ(curvedVelocity(64, 2.0), 32);  // 127 (64/127)² = 32.25
+  EXPECT_EQ(curvedVelocity(64, 0.5), 90);  // 127 (64/127)^½ = 90.15
+  EXPECT_EQ(curvedVelocity(1, 4.0), 1);    // 0 would be a note-off
+}
+
+class PlayingSynthTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    loader_.start(kRate);
+    playing_.prepare(kRate);
+  }
+  void TearDown() override {
+    playing_.release();
+    loader_.stop();
+  }
+  SynthLoader loader_;
+  PlayingSynth playing_{loader_};
+};
+
+TEST_F(PlayingSynthTest, EveryMessageIsPlayedEvenMoreThanAPieceHolds) {
+  // kMaxEvents + 100 volume messages before a note-on at the last frame of the block: the note is
+  // heard in the next block. A note-on whose frame is past the block plays at its last frame.
+  std::vector<Midi> midi;
+  for (int i = 0; i < PlayingSynth::kMaxEvents + 100; ++i)
+    midi.push_back({static_cast<uint32_t>(i), 3, {0xB0, 7, 127}});
+  midi.push_back({1023, 6, {0xF0, 0x7E, 0x7F, 0x06}});  // sysex: skipped
+  midi.push_back({1023, 3, {0x90, 69, 100}});
+  midi.push_back({5000, 3, {0x90, 72, 100}});
+  play(playing_, 1024, midi);
+  const Block next = play(playing_, 4800);
+  EXPECT_GT(next.peak(), 0.01f);
+  ASSERT_TRUE(playing_.playing());
+  EXPECT_EQ(playing_.playing()->bundled, 0);
+}
+
+TEST_F(PlayingSynthTest, ASwapFadesTheOldSynthesizerOutAndPlaysTheNew) {
+  play(playing_, 256, {{0, 3, {0x90, 69, 110}}});  // A4 on the piano
+  const Block sounding = play(playing_, 4800);
+  ASSERT_GT(sounding.peak(), 0.05f);
+  loader_.setBundled(1);  // the paper's string: no A4
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (loader_.status() == LoadStatus::loading && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  ASSERT_EQ(loader_.status(), LoadStatus::ready);
+  // The swap at the start of this block: the piano fades (all sound off, 5 ms) and is gone after
+  // the 10 ms it is heard; no step bigger than the playing note's own.
+  const Block swap = play(playing_, 960);
+  EXPECT_EQ(playing_.playing()->bundled, 1);
+  EXPECT_GT(swap.peak(0, 48), 0.01f);
+  EXPECT_LT(swap.peak(480), 1e-6f);
+  float step = 0.0f;
+  for (size_t i = 1; i < swap.left.size(); ++i)
+    step = std::max(step, std::abs(swap.left[i] - swap.left[i - 1]));
+  EXPECT_LT(step, 0.1f);
+  // The new one plays its own notes.
+  play(playing_, 256, {{0, 3, {0x90, 48, 100}}});
+  EXPECT_GT(play(playing_, 4800).peak(), 0.01f);
+}
+
+TEST_F(PlayingSynthTest, GainFollowsItsControlSmoothly) {
+  play(playing_, 256, {{0, 3, {0x90, 69, 110}}});
+  const float before = play(playing_, 4800).peak();
+  playing_.setControls({.gainDb = -60.0});
+  const Block fading = play(playing_, 4800);
+  // A one-pole of 10 ms: after 5 ms the level is still above half (e^−½ = 0.61, less the note's
+  // own decay); after 90 ms it is at the target's −60 dB (e^−9 = 1.2e−4 of the way left).
+  EXPECT_GT(fading.peak(0, 240), 0.5f * before);
+  EXPECT_LT(fading.peak(4320), 2e-3f * before);
+}
+
+}  // namespace
+}  // namespace hamiltone::plugin
