@@ -19,7 +19,8 @@ packages=(
   clang libclang-rt-14-dev   # tests/fuzz: libFuzzer targets for the MIDI reader and preset loader
   clang-22 libclang-rt-22-dev llvm-22  # tests/rtsan: RTSan test (bookworm-security; llvm-22 symbolises)
   libbenchmark-dev    # bench/
-  jackd2              # tests/e2e: a JACK server (dummy driver) for hamiltone-play's test
+  jackd2              # tests/e2e: a JACK server (dummy driver) for hamiltone-play's test, and jack_rec
+  jalv                # tests/e2e: an LV2 host on that server for the plugin's test
   python3-matplotlib python3-numpy  # scripts/validation.sh: the figures of docs/validation.md (Debian's, run by /usr/bin/python3)
 )
 

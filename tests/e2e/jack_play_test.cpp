@@ -36,6 +36,9 @@
 
 extern char** environ;
 
+#include "support/child_process.h"
+#include "support/recording.h"
+#include "support/sent_score.h"
 #include "support/spectrum.h"
 #include "support/tiny_disk.h"
 
@@ -44,23 +47,18 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 using namespace std::chrono_literals;
+using hamiltone::testing::Child;
+using hamiltone::testing::envelope;
+using hamiltone::testing::Note;
+using hamiltone::testing::notesOf;
+using hamiltone::testing::onPath;
+using hamiltone::testing::onset;
+using hamiltone::testing::parseLog;
+using hamiltone::testing::readMono;
+using hamiltone::testing::slurp;
 
 constexpr double kRate = 48000.0;
 constexpr int kPeriod = 256;  // the server's buffer; JACK MIDI moves messages once per period
-
-std::string slurp(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-bool onPath(const std::string& program) {
-  std::stringstream path(std::getenv("PATH") ? std::getenv("PATH") : "");
-  for (std::string dir; std::getline(path, dir, ':');)
-    if (::access((fs::path(dir) / program).c_str(), X_OK) == 0) return true;
-  return false;
-}
 
 // Whether this user may have real-time threads, as jackd and its clients ask for them. Without
 // them every thread of the graph competes with whatever else the host runs, and xruns are several
@@ -83,153 +81,6 @@ long xrunReports(const std::string& jackdLog) {
   for (std::string line; std::getline(lines, line);)
     if (line.find("XRun") != std::string::npos) ++reports;
   return reports;
-}
-
-// A process started with posix_spawnp, stdin from /dev/null, stdout and stderr to files. The
-// destructor stops it if it still runs: SIGTERM, then SIGKILL after 3 s.
-class Child {
- public:
-  Child(const std::vector<std::string>& argv, const std::vector<std::string>& env,
-        const fs::path& out, const fs::path& err) {
-    std::vector<char*> args, vars;
-    for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-    for (const std::string& v : env) vars.push_back(const_cast<char*>(v.c_str()));
-    args.push_back(nullptr);
-    vars.push_back(nullptr);
-    posix_spawn_file_actions_t files;
-    posix_spawn_file_actions_init(&files);
-    posix_spawn_file_actions_addopen(&files, 0, "/dev/null", O_RDONLY, 0);
-    posix_spawn_file_actions_addopen(&files, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_addopen(&files, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    if (posix_spawnp(&pid_, args[0], &files, nullptr, args.data(), vars.data()) != 0) pid_ = -1;
-    posix_spawn_file_actions_destroy(&files);
-  }
-  ~Child() {
-    if (pid_ <= 0 || status_) return;
-    signal(SIGTERM);
-    if (!wait(3.0)) {
-      signal(SIGKILL);
-      wait(60.0);
-    }
-  }
-  Child(const Child&) = delete;
-  Child& operator=(const Child&) = delete;
-
-  bool started() const { return pid_ > 0; }
-  void signal(int number) const {
-    if (pid_ > 0 && !status_) ::kill(pid_, number);
-  }
-  // The exit code (128 + N when killed by signal N), or nothing while it runs after `seconds`.
-  std::optional<int> wait(double seconds) {
-    const auto deadline = Clock::now() + std::chrono::duration<double>(seconds);
-    while (pid_ > 0 && !status_) {
-      int raw = 0;
-      if (::waitpid(pid_, &raw, WNOHANG) == pid_)
-        status_ = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128 + WTERMSIG(raw);
-      else if (Clock::now() >= deadline)
-        break;
-      else
-        std::this_thread::sleep_for(10ms);
-    }
-    return status_;
-  }
-
- private:
-  pid_t pid_ = -1;
-  std::optional<int> status_;
-};
-
-// The sender's log: one line per message, "SECONDS HEX …".
-struct Sent {
-  double seconds;
-  std::vector<int> bytes;
-};
-
-std::vector<Sent> parseLog(const std::string& text) {
-  std::vector<Sent> log;
-  std::istringstream lines(text);
-  for (std::string line; std::getline(lines, line);) {
-    std::istringstream fields(line);
-    Sent s{};
-    fields >> s.seconds;
-    for (std::string hex; fields >> hex;) s.bytes.push_back(std::stoi(hex, nullptr, 16));
-    if (!s.bytes.empty()) log.push_back(s);
-  }
-  return log;
-}
-
-// A struck key as the log says it should sound: from its note-on until its damper falls (note-off
-// with the pedal up, or the pedal lifting after its note-off).
-struct Note {
-  int key = 0, program = 0;
-  double on = 0.0, damped = std::numeric_limits<double>::infinity();
-  bool released = false;
-};
-
-std::vector<Note> notesOf(const std::vector<Sent>& log) {
-  std::vector<Note> notes;
-  bool pedal = false;
-  int program = 0;
-  for (const Sent& s : log) {
-    const int type = s.bytes[0] & 0xF0;
-    if (type == 0x90 && s.bytes.size() == 3 && s.bytes[2] > 0) {
-      notes.push_back({.key = s.bytes[1], .program = program, .on = s.seconds});
-    } else if ((type == 0x80 || type == 0x90) && s.bytes.size() == 3) {
-      for (Note& n : notes)
-        if (n.key == s.bytes[1] && !n.released) {
-          n.released = true;
-          if (!pedal) n.damped = s.seconds;
-        }
-    } else if (type == 0xB0 && s.bytes.size() == 3 && s.bytes[1] == 64) {
-      pedal = s.bytes[2] >= 64;
-      if (!pedal)
-        for (Note& n : notes)
-          if (n.released && std::isinf(n.damped)) n.damped = s.seconds;
-    } else if (type == 0xC0 && s.bytes.size() == 2) {
-      program = s.bytes[1];
-    }
-  }
-  return notes;
-}
-
-// Both channels summed: the pan and the two pickups colour them differently, the pitch is one.
-std::vector<double> readMono(const fs::path& path, SF_INFO& info) {
-  info = {};
-  SNDFILE* f = sf_open(path.c_str(), SFM_READ, &info);
-  if (!f || info.channels != 2) {
-    if (f) sf_close(f);
-    return {};
-  }
-  std::vector<float> samples(static_cast<size_t>(info.frames) * 2);
-  sf_readf_float(f, samples.data(), info.frames);
-  sf_close(f);
-  std::vector<double> mono(static_cast<size_t>(info.frames));
-  for (size_t i = 0; i < mono.size(); ++i) mono[i] = 0.5 * (samples[2 * i] + samples[2 * i + 1]);
-  return mono;
-}
-
-// The RMS over the 1 ms (48 samples) that end at each sample.
-std::vector<double> envelope(const std::vector<double>& x) {
-  constexpr size_t kWindow = 48;
-  std::vector<double> e(x.size());
-  double sum = 0.0;
-  for (size_t n = 0; n < x.size(); ++n) {
-    sum += x[n] * x[n];
-    if (n >= kWindow) sum -= x[n - kWindow] * x[n - kWindow];
-    e[n] = std::sqrt(std::max(sum, 0.0) / kWindow);
-  }
-  return e;
-}
-
-// The first sample in [from, to) where the envelope reaches a tenth of its largest value there.
-long onset(const std::vector<double>& e, long from, long to) {
-  from = std::max(from, 0L);
-  to = std::min(to, static_cast<long>(e.size()));
-  if (from >= to) return -1;
-  const double peak = *std::max_element(e.begin() + from, e.begin() + to);
-  long n = from;
-  while (n < to && e[n] < 0.1 * peak) ++n;
-  return n;
 }
 
 double cents(double measured, double reference) { return 1200.0 * std::log2(measured / reference); }
