@@ -24,12 +24,13 @@ CC=clang CXX=clang++ cmake -S . -B build/fuzz -G Ninja -DHAMILTONE_FUZZ=ON \
 cmake --build build/fuzz --target hamiltone_fuzzers
 ctest --test-dir build/fuzz --output-on-failure
 
-# The RealtimeSanitizer test (tests/rtsan) needs Clang 20 or later, Debian's clang-22; its tree,
-# like the fuzzers', builds only its own target (the engine and the player compiled in, without
-# render/ and app/'s audio libraries). Any allocation, lock or syscall inside Player::render fails it.
+# The RealtimeSanitizer tests (tests/rtsan) need Clang 20 or later, Debian's clang-22; their tree,
+# like the fuzzers', builds only their own targets (the engine compiled in with the player, or with
+# the plugin and DPF's CLAP entry; without render/ and app/'s audio libraries). Any allocation,
+# lock or syscall inside Player::render or the plugin's process call fails them.
 CC=clang-22 CXX=clang++-22 cmake -S . -B build/rtsan -G Ninja -DHAMILTONE_RTSAN=ON \
   -DHAMILTONE_BUILD_TESTS=OFF -DHAMILTONE_BUILD_BENCH=OFF -DHAMILTONE_BUILD_RENDER=OFF >/dev/null
-cmake --build build/rtsan --target hamiltone_player_rtsan
+cmake --build build/rtsan --target hamiltone_rtsan_tests
 ctest --test-dir build/rtsan --output-on-failure
 
 ctest --test-dir build/ci --output-on-failure -j "$(nproc)"

@@ -20,15 +20,14 @@
 
 #include "plugin_parameters.h"
 #include "support/clap_host.h"
+#include "support/clap_performance.h"
 #include "support/scratch_dir.h"
 #include "support/spectrum.h"
 
 namespace {
 
 namespace fs = std::filesystem;
-using hamiltone::testing::ClapEvent;
-using hamiltone::testing::ClapInstance;
-using hamiltone::testing::ClapLibrary;
+using namespace hamiltone::testing;
 using namespace hamiltone::plugin;
 
 const ClapLibrary& library() {
@@ -39,82 +38,9 @@ const ClapLibrary& library() {
 constexpr const char* kId = "hamiltone.synth";
 constexpr int kA4 = 69;
 
-// A message or parameter change at a time of the performance.
-struct Cue {
-  double seconds;
-  ClapEvent event;
-};
-Cue noteOn(double seconds, int key, int velocity = 100) {
-  return {seconds, ClapEvent::midiAt(0, 0x90, uint8_t(key), uint8_t(velocity))};
-}
-Cue noteOff(double seconds, int key) {
-  return {seconds, ClapEvent::midiAt(0, 0x80, uint8_t(key), 0)};
-}
-Cue param(double seconds, clap_id id, double value) {
-  return {seconds, ClapEvent::paramAt(0, id, value)};
-}
-
-struct Take {
-  double rate = 0.0;
-  std::vector<float> left, right;
-
-  std::vector<double> mono(double from, double to) const {
-    std::vector<double> x;
-    for (long n = std::lround(from * rate); n < std::min<long>(std::lround(to * rate), left.size());
-         ++n)
-      x.push_back(0.5 * (left[n] + right[n]));
-    return x;
-  }
-  double peak(double from, double to) const {
-    double p = 0.0;
-    for (double v : mono(from, to)) p = std::max(p, std::abs(v));
-    return p;
-  }
-};
-
 // Blocks of 1 frame for the first tenth of a second (the first strike lands in them), then sizes
 // that change at every call, 4096 the largest the plugin was activated for.
 const std::vector<uint32_t> kVarying = {64, 4096, 7, 333, 1, 1000, 4096, 2, 127};
-
-// Plays `seconds` with the cues at their frames, in blocks cycling through `blocks` (after the
-// first 0.1 s in single frames when `singleFramesFirst`).
-Take play(ClapInstance& plugin, double rate, double seconds, const std::vector<Cue>& cues,
-          const std::vector<uint32_t>& blocks, bool singleFramesFirst = false) {
-  Take take{rate, std::vector<float>(std::lround(seconds * rate)),
-            std::vector<float>(std::lround(seconds * rate))};
-  const long frames = static_cast<long>(take.left.size());
-  std::vector<ClapEvent> events;
-  size_t next = 0, call = 0;
-  for (long done = 0; done < frames;) {
-    long n =
-        singleFramesFirst && done < std::lround(0.1 * rate) ? 1 : blocks[call++ % blocks.size()];
-    n = std::min(n, frames - done);
-    events.clear();
-    for (; next < cues.size() && std::lround(cues[next].seconds * rate) < done + n; ++next) {
-      events.push_back(cues[next].event);
-      events.back().header.time =
-          static_cast<uint32_t>(std::max(0L, std::lround(cues[next].seconds * rate) - done));
-    }
-    plugin.process(std::span(take.left).subspan(done, n), std::span(take.right).subspan(done, n),
-                   events);
-    done += n;
-  }
-  return take;
-}
-
-// Silent blocks while the plugin's status is "loading" (a synthesizer built away from the audio
-// thread), then one more, which takes what was built; the status then.
-double settle(ClapInstance& plugin) {
-  std::vector<float> l(64), r(64);
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
-  while (plugin.param(kStatus) == double(LoadStatus::loading) &&
-         std::chrono::steady_clock::now() < deadline) {
-    plugin.process(l, r, {});
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  plugin.process(l, r, {});
-  return plugin.param(kStatus);
-}
 
 double cents(double f, double reference) { return 1200.0 * std::log2(f / reference); }
 
@@ -279,7 +205,7 @@ TEST(ClapPlugin, ChangesPresetWhilePlaying) {
   const Take before =
       play(plugin, 48000.0, 0.5, {noteOn(0.0, kA4), param(0.2, kPreset, 1.0)}, {128});
   EXPECT_GT(before.peak(0.0, 0.2), 0.05);
-  ASSERT_EQ(settle(plugin), double(LoadStatus::ready));
+  ASSERT_EQ(settle(plugin, kStatus, double(LoadStatus::loading)), double(LoadStatus::ready));
   const Take after = play(plugin, 48000.0, 1.6, {noteOn(0.05, kA4), noteOn(0.3, 48)}, {128});
   EXPECT_LT(after.peak(0.05, 0.3), 1e-6) << "A4 sounds: the piano is still playing";
   const double f1 = pitch(after, 130.8128, 0.6, 1.6);
@@ -296,7 +222,7 @@ TEST(ClapPlugin, ARefusedOverrideKeepsTheInstrumentPlaying) {
   ClapInstance plugin(library(), kId);
   ASSERT_TRUE(plugin.activate(48000.0, 1, 512));
   ASSERT_TRUE(plugin.loadState(withState(plugin.saveState(), "overrides", "string.bogus=1")));
-  EXPECT_EQ(settle(plugin), double(LoadStatus::failed));
+  EXPECT_EQ(settle(plugin, kStatus, double(LoadStatus::loading)), double(LoadStatus::failed));
   const Take take = play(plugin, 48000.0, 1.3, {noteOn(0.05, kA4), noteOff(1.25, kA4)}, {256});
   EXPECT_NEAR(centsOff(take, 440.0, 0.3, 1.2), 0.0, 3.0);
 }
