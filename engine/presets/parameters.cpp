@@ -109,7 +109,7 @@ constexpr Parameter kTable[] = {
      .model = kString,
      .perKey = true,
      .doc = "Mass per length ρA, winding included: a wound string is a plain one of density ρA/A "
-            "(data §1.5)."},
+            "(docs/instrument-data.md §1.5)."},
     {.name = "string.density_kg_m3",
      .unit = "kg/m^3",
      .min = 500,
@@ -182,7 +182,7 @@ constexpr Parameter kTable[] = {
      .defaultText = "2.312",
      .model = kString,
      .perKey = true,
-     .doc = "Felt exponent p (measured 1.5 … 3.5, data §2.3)."},
+     .doc = "Felt exponent p (measured 1.5 … 3.5, docs/instrument-data.md §2.3)."},
     {.name = "hammer.position",
      .min = 0.01,
      .max = 0.99,

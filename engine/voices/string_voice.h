@@ -49,7 +49,7 @@ constexpr double kUnresolvedEpsilonShare = 0.01;
 // ½ M_H v_max²: the energy the hardest strike gives the hammer, the voice's energy scale.
 double strikeEnergyScale(const StringPatch& patch);
 
-// σ(ξ) = σ0 + σ1 ξ is the decay rate of a mode of wavenumber² ξ; two T60s fix it (data §3.4):
+// σ(ξ) = σ0 + σ1 ξ is the decay rate of a mode of wavenumber² ξ; two T60s fix it (docs/instrument-data.md §3.4):
 // σ0 = 6.908 / T60(0 Hz), σ1 = (6.908 / T60(f) − σ0) / ξ(f), ξ(ω) from c²ξ + κ²ξ² = ω².
 struct StringLoss {
   double sigma0 = 0.0;
