@@ -55,6 +55,27 @@ HAMILTONE_TARGET void fineForces(long mv, int r, double c, double invH, const do
     gu[l] = (zetaOverS[l] * w[l] - zetaOverS[l + 1] * w[l + 1]) * invH;
 }
 
+HAMILTONE_TARGET double singleGridForces(const double* up, const double* vp, long m, double invH,
+                                         double c, double* wz, double* we, double* gu, double* gv) {
+  double sum = 0.0;
+#pragma omp simd reduction(+ : sum)
+  for (long l = 0; l < m; ++l) {
+    const double zeta = (up[l + 1] - up[l]) * invH, eta = (vp[l + 1] - vp[l]) * invH;
+    const double stretch = __builtin_sqrt((1.0 + eta) * (1.0 + eta) + zeta * zeta);
+    const double excess = (2.0 * eta + eta * eta + zeta * zeta) / (stretch + 1.0);
+    const double phi = excess / stretch;
+    wz[l] = c * phi * zeta;
+    we[l] = c * phi * (1.0 + eta);
+    sum += excess * excess;
+  }
+#pragma omp simd
+  for (long j = 0; j < m - 1; ++j) {
+    gu[j] = (wz[j] - wz[j + 1]) * invH;
+    gv[j] = (we[j] - we[j + 1]) * invH;
+  }
+  return sum;
+}
+
 HAMILTONE_TARGET void secondDifference(const double* a, double* out, long n, double c) {
   if (n == 1) {
     out[0] = -2.0 * c * a[0];
@@ -131,8 +152,14 @@ HAMILTONE_TARGET double savUpdate(long n, const double* g, const double* q, cons
 
 }  // namespace
 
-extern const Kernels kernels{
-    HAMILTONE_KERNEL_ISA, HAMILTONE_KERNEL_NAME,        cellStretches, fineForces,
-    secondDifference,     secondDifferenceOfDifference, savDots,       savUpdate};
+extern const Kernels kernels{.isa = HAMILTONE_KERNEL_ISA,
+                             .name = HAMILTONE_KERNEL_NAME,
+                             .cellStretches = cellStretches,
+                             .fineForces = fineForces,
+                             .singleGridForces = singleGridForces,
+                             .secondDifference = secondDifference,
+                             .secondDifferenceOfDifference = secondDifferenceOfDifference,
+                             .savDots = savDots,
+                             .savUpdate = savUpdate};
 
 }  // namespace hamiltone::HAMILTONE_KERNEL_NS

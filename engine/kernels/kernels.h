@@ -24,6 +24,11 @@ struct Kernels {
   // ∇_u V' = D₋ᵀ(c strain_J ζ_l/s_l): gu_l = (w_l − w_{l+1}) invH, l < m − 1. scratch: m doubles.
   void (*fineForces)(long mv, int r, double c, double invH, const double* strain, double* scratch,
                      const double* zetaOverS, double* gu);
+  // One grid (BDZ (65)): with up, vp the padded u and v (m + 1 values), ζ_l, η_l their strains
+  // and φ_l = (s_l − 1)/s_l, ∂V'/∂ζ_l = c φ_l ζ_l into wz and ∂V'/∂η_l = c φ_l (1 + η_l) into we
+  // (m each), gu = D₋ᵀwz and gv = D₋ᵀwe (m − 1 each); returns Σ (s_l − 1)².
+  double (*singleGridForces)(const double* up, const double* vp, long m, double invH, double c,
+                             double* wz, double* we, double* gu, double* gv);
   // out_j = c (a_{j−1} − 2a_j + a_{j+1}), j < n, a = 0 beyond both ends.
   void (*secondDifference)(const double* a, double* out, long n, double c);
   // The same of a − b, the difference taken as it is read.

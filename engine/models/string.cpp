@@ -160,38 +160,6 @@ double NonlinearString::singleGridPotential(const Vector& q) const {
   return 0.5 * h_ * (physics_.young * physics_.area - physics_.tension) * sum;
 }
 
-// ∂V'/∂ζ_l = c φ_l ζ_l, ∂V'/∂η_l = c φ_l (1 + η_l), c = h (EA − T0); then
-// ∇_u V' = D₋ᵀ(∂V'/∂ζ): (D₋ᵀ w)_j = (w_j − w_{j+1}) / h, likewise for v.
-double NonlinearString::singleGridGradient(const Vector& q, Vector& grad) const {
-  const Eigen::Index m = segments_;
-  const double* u = q.data();
-  const double* v = q.data() + (m - 1);
-  const double invH = 1.0 / h_;
-  const double c = h_ * (physics_.young * physics_.area - physics_.tension);
-  double* wz = work1_.data();
-  double* we = work2_.data();
-  auto segment = [&](Eigen::Index l, double zeta, double eta) {
-    double phi;
-    const double e = segmentExcess(zeta, eta, phi);
-    wz[l] = c * phi * zeta;
-    we[l] = c * phi * (1.0 + eta);
-    return e;
-  };
-  double sum =
-      segment(0, u[0] * invH, v[0] * invH) + segment(m - 1, -u[m - 2] * invH, -v[m - 2] * invH);
-#pragma omp simd reduction(+ : sum)
-  for (Eigen::Index l = 1; l < m - 1; ++l)
-    sum += segment(l, (u[l] - u[l - 1]) * invH, (v[l] - v[l - 1]) * invH);
-  double* gu = grad.data();
-  double* gv = grad.data() + (m - 1);
-#pragma omp simd
-  for (Eigen::Index j = 0; j < m - 1; ++j) {
-    gu[j] = (wz[j] - wz[j + 1]) * invH;
-    gv[j] = (we[j] - we[j + 1]) * invH;
-  }
-  return 0.5 * c * sum;
-}
-
 namespace {
 
 // η_J = (v_J − v_{J−1}) / h_v on the Mv coarse cells, v = 0 beyond both ends.
@@ -205,20 +173,35 @@ void longitudinalStrains(const double* v, Eigen::Index mv, double invHv, double*
   for (Eigen::Index j = 1; j < mv - 1; ++j) eta[j] = (v[j] - v[j - 1]) * invHv;
 }
 
-// u with its fixed ends, up[0] = up[M] = 0, so that ζ_l = (up[l+1] − up[l]) / h on every segment.
-void paddedTransverse(const double* u, Eigen::Index m, double* up) {
+// u (or v) with its fixed ends, up[0] = up[M] = 0, so that ζ_l = (up[l+1] − up[l]) / h on every
+// segment.
+void padded(const double* u, Eigen::Index m, double* up) {
   up[0] = up[m] = 0.0;
   std::copy(u, u + m - 1, up + 1);
 }
 
 }  // namespace
 
+// ∂V'/∂ζ_l = c φ_l ζ_l, ∂V'/∂η_l = c φ_l (1 + η_l), c = h (EA − T0); then
+// ∇_u V' = D₋ᵀ(∂V'/∂ζ): (D₋ᵀ w)_j = (w_j − w_{j+1}) / h, likewise for v.
+double NonlinearString::singleGridGradient(const Vector& q, Vector& grad) const {
+  const Eigen::Index m = segments_;
+  const double c = h_ * (physics_.young * physics_.area - physics_.tension);
+  double* up = work3_.data();
+  double* vp = scratch_.data();
+  padded(q.data(), m, up);
+  padded(q.data() + (m - 1), m, vp);
+  const double sum = kernels_->singleGridForces(up, vp, m, 1.0 / h_, c, work1_.data(),
+                                                work2_.data(), grad.data(), grad.data() + (m - 1));
+  return 0.5 * c * sum;
+}
+
 // ε_J = (1/r) Σ_{l∈J} (s_l − 1) into strain_J and Σ_{l∈J} 1/s_l into sumInverse_J, with ζ_l/s_l
 // into zetaOverS (SCHEMES §3b).
 void NonlinearString::cellStrains(const Vector& q, double* strain, double* sumInverse,
                                   double* zetaOverS) const {
   const Eigen::Index m = segments_, mv = grid_.longitudinal;
-  paddedTransverse(q.data(), m, work3_.data());
+  padded(q.data(), m, work3_.data());
   longitudinalStrains(q.data() + (m - 1), mv, 1.0 / hv_, cell1_.data());
   kernels_->cellStretches(work3_.data(), cell1_.data(), mv, ratio_, 1.0 / h_, scratch_.data(),
                           zetaOverS, strain, sumInverse);

@@ -62,6 +62,18 @@ TEST(Kernels, StencilsAndStretchesAreBitIdenticalOnEveryPath) {
       base.fineForces(mv, 3, 7.0, 100.0, s1.data(), scratch.data(), z1.data(), g1.data());
       path->fineForces(mv, 3, 7.0, 100.0, s1.data(), scratch.data(), z1.data(), g2.data());
       EXPECT_EQ(g1, g2) << path->name;
+      // One grid: u and v padded, m = n + 1 segments; the forces bit for bit, the sum reordered.
+      const std::vector<double> upS = randomArray(n + 2, 1e-3, 12),
+                                vp = randomArray(n + 2, 1e-4, 11);
+      std::vector<double> wz1(n + 1), we1(n + 1), gu1(n), gv1(n), wz2(n + 1), we2(n + 1), gu2(n),
+          gv2(n);
+      const double sum1 = base.singleGridForces(upS.data(), vp.data(), n + 1, 100.0, 5.0,
+                                                wz1.data(), we1.data(), gu1.data(), gv1.data());
+      const double sum2 = path->singleGridForces(upS.data(), vp.data(), n + 1, 100.0, 5.0,
+                                                 wz2.data(), we2.data(), gu2.data(), gv2.data());
+      EXPECT_EQ(gu1, gu2) << path->name;
+      EXPECT_EQ(gv1, gv2) << path->name;
+      EXPECT_NEAR(sum1, sum2, (n + 1) * 1.2e-16 * sum1) << path->name;  // all terms >= 0
     }
   }
 }
