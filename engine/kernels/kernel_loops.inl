@@ -103,38 +103,39 @@ HAMILTONE_TARGET void secondDifferenceOfDifference(const double* a, const double
 template <bool stiff, bool extra>
 HAMILTONE_TARGET void savDotsOf(long n, const double* g, const double* q, const double* qm,
                                 const double* minv, const double* kq, const double* x,
-                                double out[5]) {
+                                double xScale, double out[5]) {
   double sq = 0.0, sqm = 0.0, sMKq = 0.0, sMx = 0.0, sMg = 0.0;
 #pragma omp simd reduction(+ : sq, sqm, sMKq, sMx, sMg)
   for (long i = 0; i < n; ++i) {
     sq += g[i] * q[i];
     sqm += g[i] * qm[i];
     if constexpr (stiff) sMKq += g[i] * (minv[i] * kq[i]);
-    if constexpr (extra) sMx += g[i] * (minv[i] * x[i]);
+    if constexpr (extra) sMx += g[i] * (minv[i] * (xScale * x[i]));
     sMg += g[i] * minv[i] * g[i];
   }
   out[0] = sq, out[1] = sqm, out[2] = sMKq, out[3] = sMx, out[4] = sMg;
 }
 
 HAMILTONE_TARGET void savDots(long n, const double* g, const double* q, const double* qm,
-                              const double* minv, const double* kq, const double* x,
+                              const double* minv, const double* kq, const double* x, double xScale,
                               double out[5]) {
-  if (kq && x) return savDotsOf<true, true>(n, g, q, qm, minv, kq, x, out);
-  if (kq) return savDotsOf<true, false>(n, g, q, qm, minv, kq, x, out);
-  if (x) return savDotsOf<false, true>(n, g, q, qm, minv, kq, x, out);
-  savDotsOf<false, false>(n, g, q, qm, minv, kq, x, out);
+  if (kq && x) return savDotsOf<true, true>(n, g, q, qm, minv, kq, x, xScale, out);
+  if (kq) return savDotsOf<true, false>(n, g, q, qm, minv, kq, x, xScale, out);
+  if (x) return savDotsOf<false, true>(n, g, q, qm, minv, kq, x, xScale, out);
+  savDotsOf<false, false>(n, g, q, qm, minv, kq, x, xScale, out);
 }
 
 template <bool stiff, bool extra>
 HAMILTONE_TARGET double savUpdateOf(long n, const double* g, const double* q, const double* qm,
                                     const double* minv, const double* kq, const double* x,
-                                    double down, double kk, double c, double invUp, double* qp) {
+                                    double xScale, double down, double kk, double c, double invUp,
+                                    double* qp) {
   double sdq = 0.0;
 #pragma omp simd reduction(+ : sdq)
   for (long i = 0; i < n; ++i) {
     double b = 2.0 * q[i] - down * qm[i];
     if constexpr (stiff) b -= kk * (minv[i] * kq[i]);
-    if constexpr (extra) b -= minv[i] * x[i];
+    if constexpr (extra) b -= minv[i] * (xScale * x[i]);
     qp[i] = (b + c * (minv[i] * g[i])) * invUp;
     sdq += g[i] * (qp[i] - qm[i]);
   }
@@ -143,11 +144,13 @@ HAMILTONE_TARGET double savUpdateOf(long n, const double* g, const double* q, co
 
 HAMILTONE_TARGET double savUpdate(long n, const double* g, const double* q, const double* qm,
                                   const double* minv, const double* kq, const double* x,
-                                  double down, double kk, double c, double invUp, double* qp) {
-  if (kq && x) return savUpdateOf<true, true>(n, g, q, qm, minv, kq, x, down, kk, c, invUp, qp);
-  if (kq) return savUpdateOf<true, false>(n, g, q, qm, minv, kq, x, down, kk, c, invUp, qp);
-  if (x) return savUpdateOf<false, true>(n, g, q, qm, minv, kq, x, down, kk, c, invUp, qp);
-  return savUpdateOf<false, false>(n, g, q, qm, minv, kq, x, down, kk, c, invUp, qp);
+                                  double xScale, double down, double kk, double c, double invUp,
+                                  double* qp) {
+  if (kq && x)
+    return savUpdateOf<true, true>(n, g, q, qm, minv, kq, x, xScale, down, kk, c, invUp, qp);
+  if (kq) return savUpdateOf<true, false>(n, g, q, qm, minv, kq, x, xScale, down, kk, c, invUp, qp);
+  if (x) return savUpdateOf<false, true>(n, g, q, qm, minv, kq, x, xScale, down, kk, c, invUp, qp);
+  return savUpdateOf<false, false>(n, g, q, qm, minv, kq, x, xScale, down, kk, c, invUp, qp);
 }
 
 }  // namespace

@@ -34,15 +34,15 @@ struct Kernels {
   // The same of a − b, the difference taken as it is read.
   void (*secondDifferenceOfDifference)(const double* a, const double* b, double* out, long n,
                                        double c);
-  // The split scheme's first pass with one part loaded (sav.h): out = (gᵀq, gᵀqm, gᵀM⁻¹Kq,
-  // gᵀM⁻¹x, gᵀM⁻¹g); kq or x null: that sum is 0.
+  // The split scheme's first pass with one part loaded (sav.h), x read as xScale·x: out = (gᵀq,
+  // gᵀqm, gᵀM⁻¹Kq, gᵀM⁻¹x, gᵀM⁻¹g); kq or x null: that sum is 0.
   void (*savDots)(long n, const double* g, const double* q, const double* qm, const double* minv,
-                  const double* kq, const double* x, double out[5]);
+                  const double* kq, const double* x, double xScale, double out[5]);
   // Its second pass: qp_i = (2q_i − down qm_i − kk M⁻¹kq_i − M⁻¹x_i + c M⁻¹g_i) invUp (the kq and
-  // x terms absent when null); returns gᵀ(qp − qm).
+  // x terms absent when null, x read as xScale·x); returns gᵀ(qp − qm).
   double (*savUpdate)(long n, const double* g, const double* q, const double* qm,
-                      const double* minv, const double* kq, const double* x, double down, double kk,
-                      double c, double invUp, double* qp);
+                      const double* minv, const double* kq, const double* x, double xScale,
+                      double down, double kk, double c, double invUp, double* qp);
 };
 
 // The best path this CPU runs, or the one HAMILTONE_ISA names (portable, avx2, avx512): decided

@@ -178,15 +178,22 @@ class SavScheme {
     }
     const bool onePass = parts == 1 || loaded <= 1;
     // The loss's σ1 term and the external force enter b alike, b −= M⁻¹ extra_ with
-    // extra_ = 2σ1k C(q^n − q^{n−1}) − k² f.
+    // extra_ = 2σ1k C(q^n − q^{n−1}) − k² f. Unforced with one part loaded, the kernels scale
+    // C(q^n − q^{n−1}) as they read it (the same products, one pass fewer).
     const double* cq = nullptr;
+    double cqScale = 1.0;
     if constexpr (lossy) {
       const Vector& lossForce = loss_.frequencyForce(system_, curr_, prev_);
-      if (forced_)
+      if (forced_) {
         extra_ = (2.0 * params_.sigma1 * k) * lossForce - kk * force_;
-      else
+        cq = extra_.data();
+      } else if (onePass) {
+        cq = lossForce.data();
+        cqScale = 2.0 * params_.sigma1 * k;
+      } else {
         extra_ = (2.0 * params_.sigma1 * k) * lossForce;
-      cq = extra_.data();
+        cq = extra_.data();
+      }
     }
 
     // Pass 1: ∇V'_jᵀ of q^n, q^{n−1}, M⁻¹K q^n, M⁻¹C(q^n − q^{n−1}), and ∇V'_iᵀ M⁻¹ ∇V'_j.
@@ -197,7 +204,8 @@ class SavScheme {
     if (onePass) {
       const int a = onlyLoaded;
       double dots[5];
-      kernels_->savDots(n, g[a], q, qm, minv, splitK ? kq : nullptr, lossy ? cq : nullptr, dots);
+      kernels_->savDots(n, g[a], q, qm, minv, splitK ? kq : nullptr, lossy ? cq : nullptr, cqScale,
+                        dots);
       gq[a] = dots[0], gqm[a] = dots[1], gMKq[a] = dots[2], gMCq[a] = dots[3];
       gMg[a * parts + a] = dots[4];
     } else {
@@ -248,7 +256,7 @@ class SavScheme {
     if (onePass) {
       const int a = onlyLoaded;
       gdq[a] = kernels_->savUpdate(n, g[a], q, qm, minv, splitK ? kq : nullptr,
-                                   lossy ? cq : nullptr, down, kk, c[a], invUp, qp);
+                                   lossy ? cq : nullptr, cqScale, down, kk, c[a], invUp, qp);
     } else {
 #pragma omp simd reduction(+ : gdq[:parts])
       for (Eigen::Index i = 0; i < n; ++i) {

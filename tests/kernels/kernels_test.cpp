@@ -97,14 +97,14 @@ TEST(Kernels, SchemeSumsAgreeWithinTheirReorderingBound) {
   if (paths.empty()) GTEST_SKIP() << "this CPU runs only the portable kernels";
   for (const Kernels* path : paths) {
     double d1[5], d2[5];
-    base.savDots(n, g.data(), q.data(), qm.data(), minv.data(), kq.data(), x.data(), d1);
-    path->savDots(n, g.data(), q.data(), qm.data(), minv.data(), kq.data(), x.data(), d2);
+    base.savDots(n, g.data(), q.data(), qm.data(), minv.data(), kq.data(), x.data(), 1.0, d1);
+    path->savDots(n, g.data(), q.data(), qm.data(), minv.data(), kq.data(), x.data(), 1.0, d2);
     for (int j = 0; j < 5; ++j) EXPECT_NEAR(d1[j], d2[j], n * 1.2e-16 * bound[j]) << path->name;
     std::vector<double> p1(n), p2(n);
     const double s1 = base.savUpdate(n, g.data(), q.data(), qm.data(), minv.data(), kq.data(),
-                                     nullptr, 0.99, 1e-9, 0.3, 1.0 / 1.01, p1.data());
+                                     nullptr, 1.0, 0.99, 1e-9, 0.3, 1.0 / 1.01, p1.data());
     const double s2 = path->savUpdate(n, g.data(), q.data(), qm.data(), minv.data(), kq.data(),
-                                      nullptr, 0.99, 1e-9, 0.3, 1.0 / 1.01, p2.data());
+                                      nullptr, 1.0, 0.99, 1e-9, 0.3, 1.0 / 1.01, p2.data());
     EXPECT_EQ(p1, p2) << path->name;  // element by element: no reordering
     double sum = 0.0;
     for (long i = 0; i < n; ++i) sum += std::abs(g[i] * (p1[i] - qm[i]));
