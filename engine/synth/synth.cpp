@@ -19,6 +19,7 @@ void Synth::prepare(std::vector<Instrument> instruments, const SynthSetup& setup
   std::vector<std::vector<KeyVoice>> voices(instruments.size());
   std::vector<std::vector<bool>> hasVoice(instruments.size());
   std::vector<double> gains;
+  size_t keys = 0;
   for (size_t p = 0; p < instruments.size(); ++p) {
     const Instrument& instrument = instruments[p];
     if (instrument.polyphony < 1 || instrument.lowestNote > instrument.highestNote)
@@ -41,6 +42,7 @@ void Synth::prepare(std::vector<Instrument> instruments, const SynthSetup& setup
                                     e.what());
       }
       hasVoice[p][i] = true;
+      ++keys;
     }
     gains.push_back(std::pow(10.0, instrument.gainDb / 20.0));
   }
@@ -51,6 +53,7 @@ void Synth::prepare(std::vector<Instrument> instruments, const SynthSetup& setup
   voices_ = std::move(voices);
   hasVoice_ = std::move(hasVoice);
   gains_ = std::move(gains);
+  busy_.assign(keys, {});
   master_ = master;
   maxBlock_ = setup.maxBlock;
   program_ = 0;
@@ -216,9 +219,21 @@ void Synth::handle(const MidiMessage& m) noexcept {
 }
 
 void Synth::render(std::span<float> left, std::span<float> right) noexcept {
+  int count = 0;
   for (size_t p = 0; p < voices_.size(); ++p)
     for (KeyVoice& v : voices_[p])
-      if (v.busy()) v.process(left, right, gains_[p]);
+      if (v.busy()) busy_[count++] = {&v, gains_[p]};
+  for (int k = 0; k < count; ++k) busy_[k].voice->process(left.size(), busy_[k].gain);
+  // The keys' outputs summed in (instrument, note) order: the same float additions, in the same
+  // order, whichever thread rendered which key.
+  for (int k = 0; k < count; ++k) {
+    const std::span<const float> keyLeft = busy_[k].voice->left(),
+                                 keyRight = busy_[k].voice->right();
+    for (size_t i = 0; i < left.size(); ++i) {
+      left[i] += keyLeft[i];
+      right[i] += keyRight[i];
+    }
+  }
 }
 
 void Synth::process(std::span<float> left, std::span<float> right,

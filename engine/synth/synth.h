@@ -69,10 +69,17 @@ class Synth {
   KeyVoice* keyVoice(int program, int note);
   bool stealOne() noexcept;
 
+  struct BusyKey {
+    KeyVoice* voice;
+    double gain;  // its instrument's
+  };
+
   std::vector<Instrument> instruments_;
   std::vector<std::vector<KeyVoice>> voices_;  // [instrument][note − lowest]
   std::vector<std::vector<bool>> hasVoice_;
   std::vector<double> gains_;  // per instrument, linear
+  // The keys a piece renders, in (instrument, note) order; room for every key.
+  std::vector<BusyKey> busy_;
   MasterBus master_;
   int maxBlock_ = 0;
   int program_ = 0, polyphonyOverride_ = 0;
