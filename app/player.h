@@ -8,14 +8,9 @@
 #include <cstdint>
 
 #include "midi_input.h"
+#include "synth/nonblocking.h"
 #include "synth/spsc_queue.h"
 #include "synth/synth.h"
-
-#if defined(__clang__) && __clang_major__ >= 20
-#define HAMILTONE_NONBLOCKING [[clang::nonblocking]]
-#else
-#define HAMILTONE_NONBLOCKING
-#endif
 
 namespace hamiltone::app {
 
