@@ -28,7 +28,7 @@ namespace {
 struct PlayArguments {
   std::vector<std::string> presets, sets;
   std::string api = "jack", device, sampleRate = "48000", buffer = "128", midiPort, virtualMidi;
-  std::string record, voices;
+  std::string record, voices, threads;
   bool listDevices = false, quiet = false;
 };
 
@@ -92,6 +92,10 @@ int play(const PlayArguments& a) {
       a.device.empty() ? -1 : static_cast<int>(cli::parseInteger("--device", a.device, 0));
   const int voices =
       a.voices.empty() ? 0 : static_cast<int>(cli::parseInteger("--voices", a.voices, 1, 128));
+  const int threads =
+      a.threads.empty()
+          ? 0
+          : static_cast<int>(cli::parseInteger("--threads", a.threads, 1, Synth::kMaxThreads));
 
   std::vector<cli::InputFile> inputs;
   for (const std::string& file : a.presets) inputs.push_back({"--preset", file});
@@ -121,8 +125,10 @@ int play(const PlayArguments& a) {
   MidiInput midi(a.api);
   Synth synth;
   try {
-    synth.prepare(std::move(instruments),
-                  {.sampleRate = static_cast<double>(rate), .maxBlock = 8192, .notes = {}});
+    synth.prepare(std::move(instruments), {.sampleRate = static_cast<double>(rate),
+                                           .maxBlock = 8192,
+                                           .notes = {},
+                                           .threads = threads});
   } catch (const std::invalid_argument& e) {
     throw cli::UsageError(std::string("preset does not build at this sample rate: ") + e.what());
   }
@@ -143,8 +149,10 @@ int play(const PlayArguments& a) {
 
   const bool status = !a.quiet && ::isatty(2);
   if (!a.quiet)
-    std::fprintf(stderr, "hamiltone-play: %s, %d Hz, %u frames (%.1f ms); Ctrl-C stops\n",
-                 a.api.c_str(), rate, buffer, 1000.0 * buffer / rate);
+    std::fprintf(stderr,
+                 "hamiltone-play: %s, %d Hz, %u frames (%.1f ms), %d thread%s; Ctrl-C stops\n",
+                 a.api.c_str(), rate, buffer, 1000.0 * buffer / rate, synth.threads(),
+                 synth.threads() == 1 ? "" : "s");
   timespec wait{0, 250'000'000};
   int signal = -1;
   bool recordingFailureShown = false, lost = false;
@@ -240,6 +248,9 @@ int main(int argc, char** argv) {
       ->type_name("FILE");
   cli::addNumberOption(&app, "--voices", a.voices, "N",
                        "polyphony, 1 … 128 (default: the preset's)");
+  cli::addNumberOption(&app, "--threads", a.threads, "N",
+                       "threads rendering the keys, the audio callback's included, 1 … 256 "
+                       "(default: one per core); the sound is the same whatever N");
   app.add_flag("--list-devices", a.listDevices, "list the APIs, output devices and MIDI ports");
   app.add_flag("--quiet", a.quiet, "no status line");
   app.footer(

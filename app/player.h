@@ -1,7 +1,7 @@
 // The audio callback's work, apart from any audio API (so it can be tested and sanitised alone):
 // MIDI from the queue placed on the block's samples, the synthesizer, the recording tee, the load
 // measurement and the overload protection. Real-time safe: no allocation, lock, I/O or syscall
-// beyond reading the steady clock.
+// beyond reading the steady clock and waking the synthesizer's sleeping workers (sem_post).
 #pragma once
 
 #include <atomic>
@@ -31,10 +31,12 @@ class Player {
 
   struct Status {
     int voices = 0, limit = 0, guardEvents = 0;
-    double load = 0.0, peakLoad = 0.0;  // compute time / buffer period
-    long recordDropped = 0;             // samples the recording ring had no room for
-    long late = 0;                      // blocks whose compute time exceeded their period
-    std::uint32_t lastMessage = 0;      // status << 16 | data1 << 8 | data2; 0 before any
+    // The callback's time from its start until the last key is rendered, on whichever thread
+    // (Synth::process returns only then), over the buffer period: what the deadline sees.
+    double load = 0.0, peakLoad = 0.0;
+    long recordDropped = 0;         // samples the recording ring had no room for
+    long late = 0;                  // blocks whose compute time exceeded their period
+    std::uint32_t lastMessage = 0;  // status << 16 | data1 << 8 | data2; 0 before any
   };
   Status status() const;  // from any thread
 
