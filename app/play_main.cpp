@@ -66,6 +66,19 @@ std::string signalName(int signal) {
   return abbreviation ? std::string("SIG") + abbreviation : "signal " + std::to_string(signal);
 }
 
+// The workers take the real-time policy and priority the audio API gave its callback thread (JACK
+// with --realtime, ALSA's SCHED_RR): that thread spins until the keys the workers took are done,
+// so a worker of lower priority, kept off its core by other programs, would make it late.
+// Returns the priority it could not give them, or 0.
+int followCallbackScheduling(Synth& synth, pthread_t callback) {
+  int policy = SCHED_OTHER;
+  sched_param param{};
+  if (pthread_getschedparam(callback, &policy, &param) != 0 ||
+      (policy != SCHED_FIFO && policy != SCHED_RR))
+    return 0;
+  return synth.scheduleWorkers(policy, param.sched_priority) ? 0 : param.sched_priority;
+}
+
 int listDevices(const std::string& api) {
   std::printf("audio APIs in this build:");
   for (const std::string& a : AudioOutput::compiledApis()) std::printf(" %s", a.c_str());
@@ -155,9 +168,18 @@ int play(const PlayArguments& a) {
                  synth.threads() == 1 ? "" : "s");
   timespec wait{0, 250'000'000};
   int signal = -1;
-  bool recordingFailureShown = false, lost = false;
+  bool recordingFailureShown = false, lost = false, scheduled = false;
   while (signal < 0) {
     signal = sigtimedwait(&stopSignals, nullptr, &wait);
+    if (!scheduled && player.callbackThread()) {
+      scheduled = true;
+      const int refused = followCallbackScheduling(synth, *player.callbackThread());
+      if (refused > 0 && !a.quiet)
+        std::fprintf(stderr,
+                     "%shamiltone-play: warning: the worker threads could not take the audio "
+                     "thread's real-time priority %d; under load they may make it late\n",
+                     status ? "\n" : "", refused);
+    }
     // A server that went away (JACK shuts its clients down) leaves nothing to play on.
     if (signal < 0 && audio.lost()) {
       lost = true;

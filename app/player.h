@@ -4,8 +4,11 @@
 // beyond reading the steady clock and waking the synthesizer's sleeping workers (sem_post).
 #pragma once
 
+#include <pthread.h>
+
 #include <atomic>
 #include <cstdint>
+#include <optional>
 
 #include "midi_input.h"
 #include "synth/nonblocking.h"
@@ -39,6 +42,8 @@ class Player {
     std::uint32_t lastMessage = 0;  // status << 16 | data1 << 8 | data2; 0 before any
   };
   Status status() const;  // from any thread
+  // The thread that ran the first render(), once there was one: the audio API's callback thread.
+  std::optional<pthread_t> callbackThread() const;  // from any thread
 
  private:
   void protect(double load, double blockSeconds) noexcept;
@@ -55,6 +60,8 @@ class Player {
   std::atomic<double> load_{0.0}, peak_{0.0};
   std::atomic<long> recordDropped_{0}, late_{0};
   std::atomic<std::uint32_t> last_{0};
+  pthread_t callbackThread_{};  // written once, before callbackKnown_
+  std::atomic<bool> callbackKnown_{false};
 };
 
 }  // namespace hamiltone::app

@@ -66,6 +66,10 @@ class Synth {
   int guardEvents() const;
   long nonFiniteSamples() const { return master_.nonFinite(); }
   int threads() const { return pool_ ? pool_->threads() : 1; }
+  // The worker threads take this scheduling policy and priority (see WorkerPool::schedule).
+  bool scheduleWorkers(int policy, int priority) noexcept {
+    return pool_ && pool_->schedule(policy, priority);
+  }
   const std::vector<Instrument>& instruments() const { return instruments_; }
   // The key's voice, or nullptr when that note has none.
   const KeyVoice* voice(int program, int note) const;

@@ -65,6 +65,15 @@ void WorkerPool::stop() noexcept {
   workers_.clear();
 }
 
+bool WorkerPool::schedule(int policy, int priority) noexcept {
+  sched_param param{};
+  param.sched_priority = priority;
+  bool all = true;
+  for (auto& worker : workers_)
+    all = pthread_setschedparam(worker->thread.native_handle(), policy, &param) == 0 && all;
+  return all;
+}
+
 void WorkerPool::work(Worker& worker) noexcept {
   const ScopedFlushToZero ftz;  // as Synth::process has it on the calling thread
   for (;;) {

@@ -28,6 +28,11 @@ class WorkerPool {
 
   int threads() const { return static_cast<int>(workers_.size()) + 1; }
 
+  // Gives every worker this scheduling policy and priority (pthread_setschedparam): a caller with
+  // real-time priority should share it with the workers, or it may spin on a job that a worker
+  // of lower priority holds while other threads run. False when the system refuses (no rights).
+  bool schedule(int policy, int priority) noexcept;
+
   // Calls job(i) once for each i in [0, count), on this thread and the workers, in no set order,
   // and returns once every call has returned. Jobs run with flush-to-zero on (denormals.h) on
   // every thread, as the synthesizer runs its voices: a job's result must not depend on the thread

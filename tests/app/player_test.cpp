@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -194,6 +195,22 @@ TEST(Player, FullRecordingDropsWholeBlocksAndCountsThem) {
     EXPECT_EQ(got, blocks[n]) << "block " << n;
   }
   EXPECT_EQ(record.pop(got.data(), kSamples), 0u);
+}
+
+// hamiltone-play gives the synthesizer's workers the scheduling of the thread that calls render().
+TEST(Player, KnowsTheThreadOfItsCallback) {
+  Synth synth = prepared({pianoKeys(48, 48)});
+  SpscQueue<StampedMessage> midi(16);
+  Player player(synth, midi, nullptr, kRate, 64);
+  EXPECT_FALSE(player.callbackThread());
+  std::vector<float> interleaved(2 * 64);
+  pthread_t callback{};
+  std::thread([&] {
+    callback = pthread_self();
+    player.render(interleaved.data(), 64, kNow);
+  }).join();
+  ASSERT_TRUE(player.callbackThread());
+  EXPECT_TRUE(pthread_equal(*player.callbackThread(), callback));
 }
 
 // --- Overload protection -------------------------------------------------------------------------

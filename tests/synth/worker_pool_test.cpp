@@ -1,6 +1,6 @@
 // The worker pool: every job of every list runs exactly once and has returned when run() does,
 // whatever the threads and however the lists' lengths compare with them; jobs on the workers run
-// with flush-to-zero on and with every signal blocked.
+// with flush-to-zero on, with every signal blocked and with the scheduling they were given.
 #include "synth/worker_pool.h"
 
 #include <gtest/gtest.h>
@@ -72,6 +72,24 @@ TEST(WorkerPool, WorkersBlockEverySignalAndTheCallerKeepsItsMask) {
   };
   for (int list = 0; list < 50; ++list) pool.run(16, job);
   EXPECT_EQ(unblocked.load(), 0);
+}
+
+// SCHED_BATCH rather than a real-time policy: a test must not take real-time priority.
+TEST(WorkerPool, WorkersTakeTheSchedulingAsked) {
+  WorkerPool pool(3);
+  EXPECT_TRUE(pool.schedule(SCHED_BATCH, 0));
+  EXPECT_FALSE(pool.schedule(SCHED_FIFO, 1000));  // beyond any priority: refused
+  const std::thread::id caller = std::this_thread::get_id();
+  std::atomic<int> other{0};
+  auto job = [&](int) noexcept {
+    if (std::this_thread::get_id() == caller) return;
+    int policy = -1;
+    sched_param param{};
+    if (pthread_getschedparam(pthread_self(), &policy, &param) != 0 || policy != SCHED_BATCH)
+      other.fetch_add(1);
+  };
+  for (int list = 0; list < 50; ++list) pool.run(16, job);
+  EXPECT_EQ(other.load(), 0);
 }
 
 TEST(WorkerPool, RefusesFewerThanOneThread) { EXPECT_THROW(WorkerPool(0), std::invalid_argument); }
