@@ -26,7 +26,8 @@ ctest --test-dir build/fuzz --output-on-failure
 
 # The RealtimeSanitizer test (tests/rtsan) needs Clang 20 or later, Debian's clang-22; its tree,
 # like the fuzzers', builds only its own target (the engine and the player compiled in, without
-# render/ and app/'s audio libraries). Any allocation, lock or syscall inside Player::render fails it.
+# render/ and app/'s audio libraries). Any allocation, lock or syscall inside Player::render, or in the
+# synthesizer's worker threads while they render keys, fails it.
 CC=clang-22 CXX=clang++-22 cmake -S . -B build/rtsan -G Ninja -DHAMILTONE_RTSAN=ON \
   -DHAMILTONE_BUILD_TESTS=OFF -DHAMILTONE_BUILD_BENCH=OFF -DHAMILTONE_BUILD_RENDER=OFF >/dev/null
 cmake --build build/rtsan --target hamiltone_player_rtsan

@@ -28,8 +28,9 @@ void KeyVoice::prepare(const Instrument& instrument, int note, double sampleRate
   plate_ = std::move(plate);
   panLeft_ = std::numbers::sqrt2 * std::cos(angle);
   panRight_ = std::numbers::sqrt2 * std::sin(angle);
-  for (auto* buffer : {&voiceLeft_, &voiceRight_, &mixLeft_, &mixRight_})
+  for (auto* buffer : {&voiceLeft_, &voiceRight_, &mixLeft_, &mixRight_, &outLeft_, &outRight_})
     buffer->assign(maxBlock, 0.0f);
+  frames_ = 0;
   fadeSamples_ = std::max(1, static_cast<int>(std::lround(kFadeS * sampleRate)));
   envelopeDecay_ = std::exp(-1.0 / (kEnvelopeS * sampleRate));
   attackSamples_ = std::lround(kEnvelopeS * sampleRate);
@@ -93,9 +94,11 @@ double KeyVoice::fundamentalHz() const {
   return plate_ ? plate_->lowestModeHz() : strings_.front().fundamentalHz();
 }
 
-void KeyVoice::process(std::span<float> left, std::span<float> right, double gain) noexcept {
+void KeyVoice::process(size_t frames, double gain) noexcept {
+  frames_ = frames;
+  const std::span<float> left(outLeft_.data(), frames), right(outRight_.data(), frames);
   size_t done = 0;
-  while (done < left.size()) {
+  while (done < frames) {
     if (!fading() && pending()) {  // the fade is over (or its voices fell silent): strike
       strikeNow(pendingVelocity_);
       pendingVelocity_ = -1.0;
@@ -103,7 +106,7 @@ void KeyVoice::process(std::span<float> left, std::span<float> right, double gai
       releasePending_ = false;
     }
     const bool wasFading = fading();
-    size_t length = left.size() - done;
+    size_t length = frames - done;
     if (wasFading) length = std::min(length, static_cast<size_t>(fadeLeft_));
     render(left.subspan(done, length), right.subspan(done, length), gain);
     done += length;
@@ -113,6 +116,9 @@ void KeyVoice::process(std::span<float> left, std::span<float> right, double gai
       if (!pending()) break;
     }
   }
+  // A key whose fade ended inside the piece is silent for the rest of it.
+  std::fill(left.begin() + done, left.end(), 0.0f);
+  std::fill(right.begin() + done, right.end(), 0.0f);
 }
 
 void KeyVoice::render(std::span<float> left, std::span<float> right, double gain) noexcept {
@@ -143,8 +149,8 @@ void KeyVoice::render(std::span<float> left, std::span<float> right, double gain
                           static_cast<double>(std::abs(mixR[i])), envelope_ * envelopeDecay_});
     // Linear to zero: the last faded sample is 0, and each step is at most peak / 240 at 48 kHz.
     const double fade = fadeLeft_ > 0 ? static_cast<double>(--fadeLeft_) / fadeSamples_ : 1.0;
-    left[i] += static_cast<float>(gl * fade * mixL[i]);
-    right[i] += static_cast<float>(gr * fade * mixR[i]);
+    left[i] = static_cast<float>(gl * fade * mixL[i]);
+    right[i] = static_cast<float>(gr * fade * mixR[i]);
   }
 }
 

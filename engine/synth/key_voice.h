@@ -26,8 +26,12 @@ class KeyVoice {
   void fadeOut() noexcept;  // stolen or silenced: fades over kFadeS, then frees itself
   void setBend(double semitones) noexcept;
 
-  // Adds the key's next left.size() samples, times `gain`, into left and right. Never allocates.
-  void process(std::span<float> left, std::span<float> right, double gain) noexcept;
+  // Writes the key's next `frames` samples (at most maxBlock), times `gain`, into its own output
+  // (left(), right()): the synthesizer sums the keys' outputs in a fixed order, so the mix does not
+  // depend on which thread rendered which key. Touches nothing outside the key. Never allocates.
+  void process(size_t frames, double gain) noexcept;
+  std::span<const float> left() const { return {outLeft_.data(), frames_}; }  // the last process()
+  std::span<const float> right() const { return {outRight_.data(), frames_}; }
 
   bool sounding() const;  // a voice of the key is active
   bool fading() const { return fadeLeft_ > 0; }
@@ -50,7 +54,8 @@ class KeyVoice {
 
   std::vector<StringVoice> strings_;  // the unisons (string model)
   std::unique_ptr<PlateVoice> plate_;
-  std::vector<float> voiceLeft_, voiceRight_, mixLeft_, mixRight_;
+  std::vector<float> voiceLeft_, voiceRight_, mixLeft_, mixRight_, outLeft_, outRight_;
+  size_t frames_ = 0;  // written to the outputs by the last process()
   double panLeft_ = 1.0, panRight_ = 1.0;
   int fadeSamples_ = 1, fadeLeft_ = 0;
   double pendingVelocity_ = -1.0;  // < 0: none

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
 #include "synth/denormals.h"
 
@@ -16,9 +17,14 @@ void Synth::prepare(std::vector<Instrument> instruments, const SynthSetup& setup
   if (setup.maxBlock < 1 || setup.maxBlock > 65536)
     throw std::invalid_argument("block size " + std::to_string(setup.maxBlock) +
                                 ": must be between 1 and 65536 frames");
+  if (setup.threads < 0 || setup.threads > kMaxThreads)
+    throw std::invalid_argument("threads = " + std::to_string(setup.threads) +
+                                ": must be between 0 (one per core) and " +
+                                std::to_string(kMaxThreads));
   std::vector<std::vector<KeyVoice>> voices(instruments.size());
   std::vector<std::vector<bool>> hasVoice(instruments.size());
   std::vector<double> gains;
+  size_t keys = 0;
   for (size_t p = 0; p < instruments.size(); ++p) {
     const Instrument& instrument = instruments[p];
     if (instrument.polyphony < 1 || instrument.lowestNote > instrument.highestNote)
@@ -41,16 +47,21 @@ void Synth::prepare(std::vector<Instrument> instruments, const SynthSetup& setup
                                     e.what());
       }
       hasVoice[p][i] = true;
+      ++keys;
     }
     gains.push_back(std::pow(10.0, instrument.gainDb / 20.0));
   }
   MasterBus master;
   master.prepare(setup.sampleRate);
+  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  auto pool = std::make_unique<WorkerPool>(setup.threads > 0 ? setup.threads : cores);
 
   instruments_ = std::move(instruments);
   voices_ = std::move(voices);
   hasVoice_ = std::move(hasVoice);
   gains_ = std::move(gains);
+  busy_.assign(keys, {});
+  pool_ = std::move(pool);
   master_ = master;
   maxBlock_ = setup.maxBlock;
   program_ = 0;
@@ -216,9 +227,24 @@ void Synth::handle(const MidiMessage& m) noexcept {
 }
 
 void Synth::render(std::span<float> left, std::span<float> right) noexcept {
+  int count = 0;
   for (size_t p = 0; p < voices_.size(); ++p)
     for (KeyVoice& v : voices_[p])
-      if (v.busy()) v.process(left, right, gains_[p]);
+      if (v.busy()) busy_[count++] = {&v, gains_[p]};
+  auto renderKey = [this, frames = left.size()](int k) noexcept {
+    busy_[k].voice->process(frames, busy_[k].gain);
+  };
+  pool_->run(count, renderKey);
+  // The keys' outputs summed in (instrument, note) order: the same float additions, in the same
+  // order, whichever thread rendered which key.
+  for (int k = 0; k < count; ++k) {
+    const std::span<const float> keyLeft = busy_[k].voice->left(),
+                                 keyRight = busy_[k].voice->right();
+    for (size_t i = 0; i < left.size(); ++i) {
+      left[i] += keyLeft[i];
+      right[i] += keyRight[i];
+    }
+  }
 }
 
 void Synth::process(std::span<float> left, std::span<float> right,

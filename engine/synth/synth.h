@@ -1,8 +1,10 @@
 // The synthesizer: the loaded instruments, a voice for every key of each (built in prepare(),
 // never on the audio path), MIDI semantics, voice allocation under a polyphony limit, and the
-// master section. process() is real-time safe: no allocation, lock or I/O.
+// master section. process() is real-time safe: no allocation, lock or I/O; the keys it shares with
+// the worker threads (SynthSetup::threads) are handed over without a lock (synth/worker_pool.h).
 #pragma once
 
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -10,6 +12,7 @@
 #include "synth/instrument.h"
 #include "synth/key_voice.h"
 #include "synth/master_bus.h"
+#include "synth/worker_pool.h"
 
 namespace hamiltone {
 
@@ -25,6 +28,10 @@ struct SynthSetup {
   // Which MIDI notes get voices; empty: every note of each instrument's range. An offline render
   // that knows its notes saves the preparation of the others (plates are slow to prepare).
   std::vector<bool> notes;
+  // Threads that render the keys, the caller's included: 0, one per core; 1, the caller alone.
+  // The output is bit-identical whatever the count (each key renders into its own buffer; the
+  // buffers are summed in a fixed order).
+  int threads = 0;
 };
 
 // MIDI, omni (every channel plays the current instrument):
@@ -38,7 +45,10 @@ struct SynthSetup {
 //   beyond the last), sounding notes ring on in the old one.
 class Synth {
  public:
-  // May allocate; throws std::invalid_argument naming the instrument, note and patch field.
+  static constexpr int kMaxThreads = 256;
+
+  // May allocate and start the worker threads; throws std::invalid_argument naming the
+  // instrument, note and patch field (or the thread count).
   void prepare(std::vector<Instrument> instruments, const SynthSetup& setup);
 
   // Writes left.size() frames (right must be as long). `events` sorted by offset, each offset in
@@ -55,6 +65,11 @@ class Synth {
   int program() const { return program_; }
   int guardEvents() const;
   long nonFiniteSamples() const { return master_.nonFinite(); }
+  int threads() const { return pool_ ? pool_->threads() : 1; }
+  // The worker threads take this scheduling policy and priority (see WorkerPool::schedule).
+  bool scheduleWorkers(int policy, int priority) noexcept {
+    return pool_ && pool_->schedule(policy, priority);
+  }
   const std::vector<Instrument>& instruments() const { return instruments_; }
   // The key's voice, or nullptr when that note has none.
   const KeyVoice* voice(int program, int note) const;
@@ -69,10 +84,18 @@ class Synth {
   KeyVoice* keyVoice(int program, int note);
   bool stealOne() noexcept;
 
+  struct BusyKey {
+    KeyVoice* voice;
+    double gain;  // its instrument's
+  };
+
   std::vector<Instrument> instruments_;
   std::vector<std::vector<KeyVoice>> voices_;  // [instrument][note − lowest]
   std::vector<std::vector<bool>> hasVoice_;
   std::vector<double> gains_;  // per instrument, linear
+  // The keys a piece renders, in (instrument, note) order; room for every key.
+  std::vector<BusyKey> busy_;
+  std::unique_ptr<WorkerPool> pool_;  // renders busy_ (a pointer: the pool's threads stay put)
   MasterBus master_;
   int maxBlock_ = 0;
   int program_ = 0, polyphonyOverride_ = 0;
