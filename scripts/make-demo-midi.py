@@ -16,7 +16,7 @@ import argparse
 import pathlib
 import struct
 
-from smf import chunk, variable_length
+from smf import chunk, meta, track_chunk
 
 DIVISION = 480  # ticks per quarter note
 BAR = 4 * DIVISION
@@ -56,30 +56,6 @@ def dynamics(beat):
     if beat <= 18:
         return round(40 + (120 - 40) * beat / 18)
     return round(120 - (120 - 30) * (beat - 18) / 14)
-
-
-def meta(kind, data):
-    return bytes([0xFF, kind]) + variable_length(len(data)) + data
-
-
-def track_chunk(events):
-    """An MTrk chunk from (tick, order, event bytes), sorted by tick then order. A channel
-    message whose status repeats the previous one is written without it (running status); a
-    meta event ends the run, as the SMF specification asks, so strict readers agree."""
-    body = bytearray()
-    now, running = 0, None
-    for tick, _, event in sorted(events, key=lambda e: (e[0], e[1])):
-        body += variable_length(tick - now)
-        now = tick
-        if event[0] == 0xFF:
-            running = None
-            body += event
-        elif event[0] == running:
-            body += event[1:]
-        else:
-            running = event[0]
-            body += event
-    return chunk(b"MTrk", bytes(body))
 
 
 def tempo_track(end):
