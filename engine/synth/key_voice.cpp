@@ -6,9 +6,12 @@
 #include <cmath>
 #include <numbers>
 
+#include "voices/voice_block.h"
+
 namespace hamiltone {
 
-void KeyVoice::prepare(const Instrument& instrument, int note, double sampleRate, int maxBlock) {
+void KeyVoice::prepare(const Instrument& instrument, int note, double sampleRate, int maxBlock,
+                       bool freeQuiet) {
   std::vector<StringVoice> strings;
   std::unique_ptr<PlateVoice> plate;
   if (instrument.model == InstrumentModel::string) {
@@ -28,6 +31,14 @@ void KeyVoice::prepare(const Instrument& instrument, int note, double sampleRate
   plate_ = std::move(plate);
   panLeft_ = std::numbers::sqrt2 * std::cos(angle);
   panRight_ = std::numbers::sqrt2 * std::sin(angle);
+  // A voice is silent under QuietDetector::kFloor of full scale at the instrument's output: in
+  // its own units, divided by the instrument's gain and the louder side's pan, and shared among
+  // the key's strings so that all of them together stay under it.
+  const double heard = std::pow(10.0, instrument.gainDb / 20.0) * std::max(panLeft_, panRight_) *
+                       static_cast<double>(std::max<size_t>(strings_.size(), 1));
+  const double floor = freeQuiet ? QuietDetector::kFloor / heard : -1.0;
+  for (StringVoice& s : strings_) s.setQuietFloor(floor);
+  if (plate_) plate_->setQuietFloor(floor);
   for (auto* buffer : {&voiceLeft_, &voiceRight_, &mixLeft_, &mixRight_})
     buffer->assign(maxBlock, 0.0f);
   fadeSamples_ = std::max(1, static_cast<int>(std::lround(kFadeS * sampleRate)));

@@ -16,8 +16,11 @@ class KeyVoice {
   static constexpr double kFadeS = 0.005;     // a stolen or silenced voice fades over 5 ms
   static constexpr double kEnvelopeS = 0.05;  // the loudness follower's release time constant
 
-  // May allocate; throws std::invalid_argument naming the patch field (from the voices).
-  void prepare(const Instrument& instrument, int note, double sampleRate, int maxBlock);
+  // May allocate; throws std::invalid_argument naming the patch field (from the voices). With
+  // freeQuiet false no voice frees itself when it falls silent (QuietDetector): it sounds until
+  // stolen or silenced, the reference the tests of that culling compare against.
+  void prepare(const Instrument& instrument, int note, double sampleRate, int maxBlock,
+               bool freeQuiet);
 
   // 0 … 1. A sounding key is struck again where it is; a fading one is struck once its fade
   // ends, from rest (the note-on is pending until then).

@@ -35,7 +35,8 @@ void Synth::prepare(std::vector<Instrument> instruments, const SynthSetup& setup
           (note >= static_cast<int>(setup.notes.size()) || !setup.notes[note]))
         continue;
       try {
-        voices[p][i].prepare(instrument, note, setup.sampleRate, setup.maxBlock);
+        voices[p][i].prepare(instrument, note, setup.sampleRate, setup.maxBlock,
+                             setup.freeQuietVoices);
       } catch (const std::exception& e) {
         throw std::invalid_argument(instrument.source + ": note " + std::to_string(note) + ": " +
                                     e.what());

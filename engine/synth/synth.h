@@ -25,6 +25,9 @@ struct SynthSetup {
   // Which MIDI notes get voices; empty: every note of each instrument's range. An offline render
   // that knows its notes saves the preparation of the others (plates are slow to prepare).
   std::vector<bool> notes;
+  // Voices free themselves once silent, held or not (QuietDetector); false keeps them until they
+  // are stolen or silenced, for tests to compare against.
+  bool freeQuietVoices = true;
 };
 
 // MIDI, omni (every channel plays the current instrument):

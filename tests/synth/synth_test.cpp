@@ -10,55 +10,23 @@
 #include <vector>
 
 #include "support/modal.h"
+#include "support/synth_takes.h"
 #include "support/test_instruments.h"
 #include "synth/denormals.h"
 
 namespace hamiltone {
 namespace {
 
+using testing::cc;
+using testing::off;
+using testing::on;
+using testing::peak;
 using testing::pianoKeys;
+using testing::prepared;
+using testing::render;
+using testing::Take;
 
-constexpr double kRate = 48000.0;
-
-MidiMessage on(int note, int velocity = 100) { return {0x90, uint8_t(note), uint8_t(velocity)}; }
-MidiMessage off(int note) { return {0x80, uint8_t(note), 0}; }
-MidiMessage cc(int controller, int value) { return {0xB0, uint8_t(controller), uint8_t(value)}; }
-
-struct Take {
-  std::vector<float> left, right;
-};
-
-// Renders `seconds` with the messages at their times (seconds), in blocks of `block` frames.
-Take render(Synth& synth, std::vector<TimedMessage> messages, double seconds, int block) {
-  const long frames = std::lround(seconds * kRate);
-  Take take{std::vector<float>(frames), std::vector<float>(frames)};
-  std::vector<SynthEvent> events;
-  size_t next = 0;
-  for (long start = 0; start < frames; start += block) {
-    const long n = std::min<long>(block, frames - start);
-    events.clear();
-    while (next < messages.size() && std::lround(messages[next].seconds * kRate) < start + n) {
-      events.push_back(
-          {int(std::lround(messages[next].seconds * kRate) - start), messages[next].message});
-      ++next;
-    }
-    synth.process(std::span(take.left).subspan(start, n), std::span(take.right).subspan(start, n),
-                  events);
-  }
-  return take;
-}
-
-Synth prepared(std::vector<Instrument> instruments, int maxBlock = 256) {
-  Synth synth;
-  synth.prepare(std::move(instruments), {.sampleRate = kRate, .maxBlock = maxBlock, .notes = {}});
-  return synth;
-}
-
-float peak(const std::vector<float>& x, size_t from = 0, size_t to = SIZE_MAX) {
-  float p = 0.0f;
-  for (size_t i = from; i < std::min(to, x.size()); ++i) p = std::max(p, std::abs(x[i]));
-  return p;
-}
+constexpr double kRate = testing::kTakeRate;
 
 TEST(Synth, SustainHoldsReleasedNotesUntilThePedalLifts) {
   Synth synth = prepared({pianoKeys(48, 50)});
