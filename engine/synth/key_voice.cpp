@@ -48,7 +48,7 @@ void KeyVoice::prepare(const Instrument& instrument, int note, double sampleRate
   fadeLeft_ = 0;
   pendingVelocity_ = -1.0;
   releasePending_ = false;
-  envelope_ = 0.0;
+  envelope_ = loudest_ = 0.0;
   down = sustained = false;
 }
 
@@ -64,6 +64,7 @@ void KeyVoice::strike(double velocity, long order) noexcept {
 }
 
 void KeyVoice::strikeNow(double velocity) noexcept {
+  loudest_ = envelope_;
   for (StringVoice& s : strings_) s.noteOn(velocity);
   if (plate_) plate_->noteOn(velocity);
 }
@@ -86,6 +87,11 @@ void KeyVoice::fadeOut() noexcept {
 
 void KeyVoice::setBend(double semitones) noexcept {
   for (StringVoice& s : strings_) s.setBend(semitones);
+}
+
+double KeyVoice::level() const {
+  if (sinceStrike_ < attackSamples_) return 1.0;
+  return loudest_ > 0.0 ? envelope_ / loudest_ : 0.0;
 }
 
 bool KeyVoice::sounding() const {
@@ -152,6 +158,7 @@ void KeyVoice::render(std::span<float> left, std::span<float> right, double gain
   for (size_t i = 0; i < n; ++i) {
     envelope_ = std::max({static_cast<double>(std::abs(mixL[i])),
                           static_cast<double>(std::abs(mixR[i])), envelope_ * envelopeDecay_});
+    loudest_ = std::max(loudest_, envelope_);
     // Linear to zero: the last faded sample is 0, and each step is at most peak / 240 at 48 kHz.
     const double fade = fadeLeft_ > 0 ? static_cast<double>(--fadeLeft_) / fadeSamples_ : 1.0;
     left[i] += static_cast<float>(gl * fade * mixL[i]);

@@ -51,13 +51,17 @@ class Synth {
   void handle(const MidiMessage& message) noexcept;  // now, between two samples
 
   // The limit on sounding keys; 0 restores the instrument's own polyphony. Keys beyond a lowered
-  // limit fade out at once (released keys first, the oldest of them; then the quietest).
+  // limit fade out at once, those furthest below their own peak first (as stealOne()).
   void setPolyphony(int voices) noexcept;
   int polyphony() const;
   int activeVoices() const;
   int program() const { return program_; }
   int guardEvents() const;
   long nonFiniteSamples() const { return master_.nonFinite(); }
+  // Keys stolen since prepare(), and the highest level under its own peak any of them had when
+  // taken (KeyVoice::level: 1e-3 is −60 dB) — how much sound the polyphony limit has cut.
+  long steals() const { return steals_; }
+  double loudestSteal() const { return loudestSteal_; }
   const std::vector<Instrument>& instruments() const { return instruments_; }
   // The key's voice, or nullptr when that note has none.
   const KeyVoice* voice(int program, int note) const;
@@ -83,6 +87,8 @@ class Synth {
   bool sustain_ = false;
   double bend_ = 0.0;  // −1 … 1 of the range
   long strikes_ = 0;
+  long steals_ = 0;
+  double loudestSteal_ = 0.0;
 };
 
 }  // namespace hamiltone

@@ -66,21 +66,31 @@ TEST(Synth, AllNotesOffReleasesHeldKeysAndAllSoundOffSilences) {
   EXPECT_LT(peak(take.left, 12000), 1e-3f * peak(before.left));
 }
 
-TEST(Synth, PolyphonyLimitStealsReleasedKeysFirstThenTheQuietest) {
-  Synth synth = prepared({pianoKeys(48, 60, 3)});
-  // 48 soft and held, 50 loud and held, 52 loud and released: at the limit of 3, a fourth key
-  // steals 52 (released) although 48 is quieter.
-  render(synth, {{0.0, on(48, 20)}, {0.0, on(50, 127)}, {0.0, on(52, 127)}, {0.05, off(52)}}, 0.1,
+// At the limit the key furthest below its own peak goes, held or not: 48, held, decays fast
+// (T60 1 s) and after a second is further below its peak (about −60 dB) than 50, released 0.15 s
+// ago (damper 0.25 s: about −26 dB); then 50 goes before 52, held and struck 0.1 s ago. Each
+// steal is counted with the stolen key's level.
+TEST(Synth, PolyphonyLimitStealsTheKeyFurthestBelowItsPeak) {
+  Instrument piano = pianoKeys(48, 60, 3);
+  piano.keys[0].patch.t60Low = piano.keys[0].patch.t60High = 1.0;
+  Synth synth = prepared({piano});
+  render(synth, {{0.0, on(48, 127)}, {0.8, on(50, 127)}, {0.85, off(50)}, {0.9, on(52, 127)}}, 1.0,
          64);
   ASSERT_EQ(synth.activeVoices(), 3);
+  const double held = synth.voice(0, 48)->level(), released = synth.voice(0, 50)->level();
+  ASSERT_LT(held, released);
+  ASSERT_LT(released, synth.voice(0, 52)->level());
   render(synth, {{0.0, on(55)}}, 0.02, 64);
-  EXPECT_FALSE(synth.voice(0, 52)->sounding());
-  EXPECT_TRUE(synth.voice(0, 48)->sounding());
-  EXPECT_EQ(synth.activeVoices(), 3);
-  // All held now: the quietest (48, struck softly) goes.
-  render(synth, {{0.0, on(57)}}, 0.02, 64);
   EXPECT_FALSE(synth.voice(0, 48)->sounding());
   EXPECT_TRUE(synth.voice(0, 50)->sounding());
+  EXPECT_EQ(synth.activeVoices(), 3);
+  render(synth, {{0.0, on(57)}}, 0.02, 64);
+  EXPECT_FALSE(synth.voice(0, 50)->sounding());
+  EXPECT_TRUE(synth.voice(0, 52)->sounding());
+  EXPECT_EQ(synth.steals(), 2);
+  // The louder of the two: 50, 20 ms further into its damping than when measured.
+  EXPECT_LT(synth.loudestSteal(), released);
+  EXPECT_GT(synth.loudestSteal(), held);
   // The CLI's --voices overrides the preset's polyphony.
   synth.setPolyphony(1);
   render(synth, {{0.0, on(59)}}, 0.02, 64);
