@@ -12,18 +12,15 @@ channel messages share a status byte (running status), so the file exercises wha
 Every note is within MIDI 36-96. Python 3 standard library only.
 """
 
-import argparse
-import pathlib
 import struct
 
-from smf import chunk, meta, track_chunk
+from smf import (CONTROLLER, NOTE_OFF, NOTE_ON, PROGRAM, SUSTAIN, chunk, meta, track_chunk,
+                 write_file)
 
 DIVISION = 480  # ticks per quarter note
 BAR = 4 * DIVISION
 LEGATO = 0.95  # a note sounds for this fraction of its written length
 CHANNEL = 0
-NOTE_OFF, NOTE_ON, CONTROLLER, PROGRAM = 0x80, 0x90, 0xB0, 0xC0
-SUSTAIN = 64
 
 # (bass, chord) for each bar.
 HARMONY = [
@@ -99,13 +96,7 @@ def demo():
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    default = pathlib.Path(__file__).resolve().parent.parent / "presets" / "demo.mid"
-    parser.add_argument("path", nargs="?", default=default, type=pathlib.Path,
-                        help="the file to write (default: presets/demo.mid in the repository)")
-    path = parser.parse_args().path
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_bytes(demo())
+    write_file(__doc__, "demo.mid", demo())
 
 
 if __name__ == "__main__":
