@@ -21,7 +21,7 @@ inline void silence(std::span<float> left, std::span<float> right, size_t rightC
 // together stay under it); the relative bound keeps a soft note to its own decay. Over those 50
 // ms, longer than the lowest string's half period, the output fades to zero, so freeing it
 // never clicks, and what is cut is under both bounds. The follower cannot fall 80 dB in less
-// than 184 ms (20 ms · ln 10⁴), so no voice goes within a quarter second of its loudest. All of
+// than 184 ms (20 ms · ln 10⁴), so no voice goes within 0.23 s of its loudest. All of
 // it sample by sample — a peak follower with a 20 ms release bridges the zero crossings — so it
 // does not depend on the block size. It listens to the output, not the energy: near rest the
 // SAV can keep energy where no pickup hears it — a static longitudinal stretch held by ψ, or a
