@@ -66,8 +66,8 @@ void Player::render(float* interleaved, int frames, std::int64_t nowNs) noexcept
   guard_.store(synth_.guardEvents(), std::memory_order_relaxed);
 }
 
-// Near the deadline the limit drops by one (the synth fades the released keys first, oldest
-// first); after a second under kRelief it rises by one, back to the preset's polyphony.
+// Near the deadline the limit drops by one (the synth fades the keys furthest below their own
+// peak first); after a second under kRelief it rises by one, back to the preset's polyphony.
 void Player::protect(double load, double blockSeconds) noexcept {
   if (load > kOverload && limit_ > 1) {
     limit_ = std::max(1, std::min(limit_, synth_.activeVoices()) - 1);

@@ -127,6 +127,8 @@ int run(const RenderArguments& a) {
   if (!a.quiet) {
     std::fprintf(stderr, "hamiltone-render: %s: %s\n", a.out.c_str(),
                  renderSummary(stats.seconds, stats.wallSeconds).c_str());
+    std::fprintf(stderr, "hamiltone-render: %s\n",
+                 stealSummary(stats.steals, stats.loudestSteal, synth.polyphony()).c_str());
   }
   return 0;
 }

@@ -41,7 +41,8 @@ void Synth::prepare(std::vector<Instrument> instruments, const SynthSetup& setup
           (note >= static_cast<int>(setup.notes.size()) || !setup.notes[note]))
         continue;
       try {
-        voices[p][i].prepare(instrument, note, setup.sampleRate, setup.maxBlock);
+        voices[p][i].prepare(instrument, note, setup.sampleRate, setup.maxBlock,
+                             setup.freeQuietVoices);
       } catch (const std::exception& e) {
         throw std::invalid_argument(instrument.source + ": note " + std::to_string(note) + ": " +
                                     e.what());
@@ -68,7 +69,8 @@ void Synth::prepare(std::vector<Instrument> instruments, const SynthSetup& setup
   std::fill(std::begin(downProgram_), std::end(downProgram_), -1);
   sustain_ = false;
   bend_ = 0.0;
-  strikes_ = 0;
+  strikes_ = steals_ = 0;
+  loudestSteal_ = 0.0;
 }
 
 KeyVoice* Synth::keyVoice(int program, int note) {
@@ -107,22 +109,26 @@ int Synth::guardEvents() const {
   return events;
 }
 
-// Released keys first (neither held nor sustained), the oldest of them, as they have decayed
-// longest; else the quietest held key (KeyVoice::loudness), the oldest on a tie. It fades out over
-// 5 ms. False when no key can be taken (all are fading already).
+// The key furthest below its own peak (KeyVoice::level): the furthest into its decay, whether
+// a damper or its own loss is taking it there, so the least of what it still had to sound is
+// cut; on a tie (keys just struck count as at their peak) a released key (neither held nor
+// sustained) first, then the oldest. It fades out over 5 ms. False when no key can be taken (all
+// are fading already).
 bool Synth::stealOne() noexcept {
   KeyVoice* victim = nullptr;
   auto better = [&](const KeyVoice& v) {
     if (!victim) return true;
+    if (v.level() != victim->level()) return v.level() < victim->level();
     const bool free = !v.down && !v.sustained, victimFree = !victim->down && !victim->sustained;
     if (free != victimFree) return free;
-    if (!free && v.loudness() != victim->loudness()) return v.loudness() < victim->loudness();
     return v.order() < victim->order();
   };
   for (auto& keys : voices_)
     for (KeyVoice& v : keys)
       if (v.sounding() && !v.fading() && !v.pending() && better(v)) victim = &v;
   if (!victim) return false;
+  ++steals_;
+  loudestSteal_ = std::max(loudestSteal_, victim->level());
   victim->fadeOut();
   return true;
 }

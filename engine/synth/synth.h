@@ -32,6 +32,9 @@ struct SynthSetup {
   // The output is bit-identical whatever the count (each key renders into its own buffer; the
   // buffers are summed in a fixed order).
   int threads = 0;
+  // Voices free themselves once silent, held or not (QuietDetector); false keeps them until they
+  // are stolen or silenced, for tests to compare against.
+  bool freeQuietVoices = true;
 };
 
 // MIDI, omni (every channel plays the current instrument):
@@ -58,7 +61,7 @@ class Synth {
   void handle(const MidiMessage& message) noexcept;  // now, between two samples
 
   // The limit on sounding keys; 0 restores the instrument's own polyphony. Keys beyond a lowered
-  // limit fade out at once (released keys first, the oldest of them; then the quietest).
+  // limit fade out at once, those furthest below their own peak first (as stealOne()).
   void setPolyphony(int voices) noexcept;
   int polyphony() const;
   int activeVoices() const;
@@ -70,6 +73,10 @@ class Synth {
   bool scheduleWorkers(int policy, int priority) noexcept {
     return pool_ && pool_->schedule(policy, priority);
   }
+  // Keys stolen since prepare(), and the highest level under its own peak any of them had when
+  // taken (KeyVoice::level: 1e-3 is −60 dB) — how much sound the polyphony limit has cut.
+  long steals() const { return steals_; }
+  double loudestSteal() const { return loudestSteal_; }
   const std::vector<Instrument>& instruments() const { return instruments_; }
   // The key's voice, or nullptr when that note has none.
   const KeyVoice* voice(int program, int note) const;
@@ -103,6 +110,8 @@ class Synth {
   bool sustain_ = false;
   double bend_ = 0.0;  // −1 … 1 of the range
   long strikes_ = 0;
+  long steals_ = 0;
+  double loudestSteal_ = 0.0;
 };
 
 }  // namespace hamiltone

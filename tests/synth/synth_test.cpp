@@ -11,57 +11,24 @@
 #include <vector>
 
 #include "support/modal.h"
+#include "support/synth_takes.h"
 #include "support/test_instruments.h"
 #include "synth/denormals.h"
 
 namespace hamiltone {
 namespace {
 
+using testing::cc;
+using testing::off;
+using testing::on;
+using testing::peak;
 using testing::pianoKeys;
+using testing::prepared;
+using testing::render;
 using testing::smallPlate;
+using testing::Take;
 
-constexpr double kRate = 48000.0;
-
-MidiMessage on(int note, int velocity = 100) { return {0x90, uint8_t(note), uint8_t(velocity)}; }
-MidiMessage off(int note) { return {0x80, uint8_t(note), 0}; }
-MidiMessage cc(int controller, int value) { return {0xB0, uint8_t(controller), uint8_t(value)}; }
-
-struct Take {
-  std::vector<float> left, right;
-};
-
-// Renders `seconds` with the messages at their times (seconds), in blocks of `block` frames.
-Take render(Synth& synth, std::vector<TimedMessage> messages, double seconds, int block) {
-  const long frames = std::lround(seconds * kRate);
-  Take take{std::vector<float>(frames), std::vector<float>(frames)};
-  std::vector<SynthEvent> events;
-  size_t next = 0;
-  for (long start = 0; start < frames; start += block) {
-    const long n = std::min<long>(block, frames - start);
-    events.clear();
-    while (next < messages.size() && std::lround(messages[next].seconds * kRate) < start + n) {
-      events.push_back(
-          {int(std::lround(messages[next].seconds * kRate) - start), messages[next].message});
-      ++next;
-    }
-    synth.process(std::span(take.left).subspan(start, n), std::span(take.right).subspan(start, n),
-                  events);
-  }
-  return take;
-}
-
-Synth prepared(std::vector<Instrument> instruments, int maxBlock = 256, int threads = 0) {
-  Synth synth;
-  synth.prepare(std::move(instruments),
-                {.sampleRate = kRate, .maxBlock = maxBlock, .notes = {}, .threads = threads});
-  return synth;
-}
-
-float peak(const std::vector<float>& x, size_t from = 0, size_t to = SIZE_MAX) {
-  float p = 0.0f;
-  for (size_t i = from; i < std::min(to, x.size()); ++i) p = std::max(p, std::abs(x[i]));
-  return p;
-}
+constexpr double kRate = testing::kTakeRate;
 
 TEST(Synth, SustainHoldsReleasedNotesUntilThePedalLifts) {
   Synth synth = prepared({pianoKeys(48, 50)});
@@ -101,21 +68,31 @@ TEST(Synth, AllNotesOffReleasesHeldKeysAndAllSoundOffSilences) {
   EXPECT_LT(peak(take.left, 12000), 1e-3f * peak(before.left));
 }
 
-TEST(Synth, PolyphonyLimitStealsReleasedKeysFirstThenTheQuietest) {
-  Synth synth = prepared({pianoKeys(48, 60, 3)});
-  // 48 soft and held, 50 loud and held, 52 loud and released: at the limit of 3, a fourth key
-  // steals 52 (released) although 48 is quieter.
-  render(synth, {{0.0, on(48, 20)}, {0.0, on(50, 127)}, {0.0, on(52, 127)}, {0.05, off(52)}}, 0.1,
+// At the limit the key furthest below its own peak goes, held or not: 48, held, decays fast
+// (T60 1 s) and after a second is further below its peak (about −60 dB) than 50, released 0.15 s
+// ago (damper 0.25 s: about −26 dB); then 50 goes before 52, held and struck 0.1 s ago. Each
+// steal is counted with the stolen key's level.
+TEST(Synth, PolyphonyLimitStealsTheKeyFurthestBelowItsPeak) {
+  Instrument piano = pianoKeys(48, 60, 3);
+  piano.keys[0].patch.t60Low = piano.keys[0].patch.t60High = 1.0;
+  Synth synth = prepared({piano});
+  render(synth, {{0.0, on(48, 127)}, {0.8, on(50, 127)}, {0.85, off(50)}, {0.9, on(52, 127)}}, 1.0,
          64);
   ASSERT_EQ(synth.activeVoices(), 3);
+  const double held = synth.voice(0, 48)->level(), released = synth.voice(0, 50)->level();
+  ASSERT_LT(held, released);
+  ASSERT_LT(released, synth.voice(0, 52)->level());
   render(synth, {{0.0, on(55)}}, 0.02, 64);
-  EXPECT_FALSE(synth.voice(0, 52)->sounding());
-  EXPECT_TRUE(synth.voice(0, 48)->sounding());
-  EXPECT_EQ(synth.activeVoices(), 3);
-  // All held now: the quietest (48, struck softly) goes.
-  render(synth, {{0.0, on(57)}}, 0.02, 64);
   EXPECT_FALSE(synth.voice(0, 48)->sounding());
   EXPECT_TRUE(synth.voice(0, 50)->sounding());
+  EXPECT_EQ(synth.activeVoices(), 3);
+  render(synth, {{0.0, on(57)}}, 0.02, 64);
+  EXPECT_FALSE(synth.voice(0, 50)->sounding());
+  EXPECT_TRUE(synth.voice(0, 52)->sounding());
+  EXPECT_EQ(synth.steals(), 2);
+  // The louder of the two: 50, 20 ms further into its damping than when measured.
+  EXPECT_LT(synth.loudestSteal(), released);
+  EXPECT_GT(synth.loudestSteal(), held);
   // The CLI's --voices overrides the preset's polyphony.
   synth.setPolyphony(1);
   render(synth, {{0.0, on(59)}}, 0.02, 64);
@@ -166,7 +143,7 @@ TEST(Synth, OutputIsBitIdenticalWhateverTheThreadCount) {
       {0.12, cc(120, 0)},  {0.122, on(55, 80)},   {0.13, off(55)},      {0.14, on(57, 127)}};
   std::vector<Take> takes;
   for (int threads : {1, 2, 3, 4}) {
-    Synth synth = prepared({pianoKeys(48, 60, 4), smallPlate()}, 100, threads);
+    Synth synth = prepared({pianoKeys(48, 60, 4), smallPlate()}, 100, true, threads);
     EXPECT_EQ(synth.threads(), threads);
     takes.push_back(render(synth, score, 0.3, 100));
   }
