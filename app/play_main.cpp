@@ -29,7 +29,7 @@ namespace {
 struct PlayArguments {
   std::vector<std::string> presets, sets;
   std::string api = "jack", device, sampleRate = "48000", buffer = "128", midiPort, virtualMidi;
-  std::string record, voices;
+  std::string record, voices, threads;
   bool listDevices = false, quiet = false;
 };
 
@@ -67,6 +67,19 @@ std::string signalName(int signal) {
   return abbreviation ? std::string("SIG") + abbreviation : "signal " + std::to_string(signal);
 }
 
+// The workers take the real-time policy and priority the audio API gave its callback thread (JACK
+// with --realtime, ALSA's SCHED_RR): that thread spins until the keys the workers took are done,
+// so a worker of lower priority, kept off its core by other programs, would make it late.
+// Returns the priority it could not give them, or 0.
+int followCallbackScheduling(Synth& synth, pthread_t callback) {
+  int policy = SCHED_OTHER;
+  sched_param param{};
+  if (pthread_getschedparam(callback, &policy, &param) != 0 ||
+      (policy != SCHED_FIFO && policy != SCHED_RR))
+    return 0;
+  return synth.scheduleWorkers(policy, param.sched_priority) ? 0 : param.sched_priority;
+}
+
 int listDevices(const std::string& api) {
   std::printf("audio APIs in this build:");
   for (const std::string& a : AudioOutput::compiledApis()) std::printf(" %s", a.c_str());
@@ -93,6 +106,10 @@ int play(const PlayArguments& a) {
       a.device.empty() ? -1 : static_cast<int>(cli::parseInteger("--device", a.device, 0));
   const int voices =
       a.voices.empty() ? 0 : static_cast<int>(cli::parseInteger("--voices", a.voices, 1, 128));
+  const int threads =
+      a.threads.empty()
+          ? 0
+          : static_cast<int>(cli::parseInteger("--threads", a.threads, 1, Synth::kMaxThreads));
 
   std::vector<cli::InputFile> inputs;
   for (const std::string& file : a.presets) inputs.push_back({"--preset", file});
@@ -122,8 +139,10 @@ int play(const PlayArguments& a) {
   MidiInput midi(a.api);
   Synth synth;
   try {
-    synth.prepare(std::move(instruments),
-                  {.sampleRate = static_cast<double>(rate), .maxBlock = 8192, .notes = {}});
+    synth.prepare(std::move(instruments), {.sampleRate = static_cast<double>(rate),
+                                           .maxBlock = 8192,
+                                           .notes = {},
+                                           .threads = threads});
   } catch (const std::invalid_argument& e) {
     throw cli::UsageError(std::string("preset does not build at this sample rate: ") + e.what());
   }
@@ -144,13 +163,24 @@ int play(const PlayArguments& a) {
 
   const bool status = !a.quiet && ::isatty(2);
   if (!a.quiet)
-    std::fprintf(stderr, "hamiltone-play: %s, %d Hz, %u frames (%.1f ms); Ctrl-C stops\n",
-                 a.api.c_str(), rate, buffer, 1000.0 * buffer / rate);
+    std::fprintf(stderr,
+                 "hamiltone-play: %s, %d Hz, %u frames (%.1f ms), %d thread%s; Ctrl-C stops\n",
+                 a.api.c_str(), rate, buffer, 1000.0 * buffer / rate, synth.threads(),
+                 synth.threads() == 1 ? "" : "s");
   timespec wait{0, 250'000'000};
   int signal = -1;
-  bool recordingFailureShown = false, lost = false;
+  bool recordingFailureShown = false, lost = false, scheduled = false;
   while (signal < 0) {
     signal = sigtimedwait(&stopSignals, nullptr, &wait);
+    if (!scheduled && player.callbackThread()) {
+      scheduled = true;
+      const int refused = followCallbackScheduling(synth, *player.callbackThread());
+      if (refused > 0 && !a.quiet)
+        std::fprintf(stderr,
+                     "%shamiltone-play: warning: the worker threads could not take the audio "
+                     "thread's real-time priority %d; under load they may make it late\n",
+                     status ? "\n" : "", refused);
+    }
     // A server that went away (JACK shuts its clients down) leaves nothing to play on.
     if (signal < 0 && audio.lost()) {
       lost = true;
@@ -242,6 +272,9 @@ int main(int argc, char** argv) {
       ->type_name("FILE");
   cli::addNumberOption(&app, "--voices", a.voices, "N",
                        "polyphony, 1 … 128 (default: the preset's)");
+  cli::addNumberOption(&app, "--threads", a.threads, "N",
+                       "threads rendering the keys, the audio callback's included, 1 … 256 "
+                       "(default: one per core); the sound is the same whatever N");
   app.add_flag("--list-devices", a.listDevices, "list the APIs, output devices and MIDI ports");
   app.add_flag("--quiet", a.quiet, "no status line");
   app.footer(

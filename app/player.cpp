@@ -24,6 +24,10 @@ Player::Player(Synth& synth, SpscQueue<StampedMessage>& midi, SpscQueue<float>* 
 
 void Player::render(float* interleaved, int frames, std::int64_t nowNs) noexcept {
   const auto start = std::chrono::steady_clock::now();
+  if (!callbackKnown_.load(std::memory_order_relaxed)) {
+    callbackThread_ = pthread_self();
+    callbackKnown_.store(true, std::memory_order_release);
+  }
   frames = std::min(frames, static_cast<int>(left_.size()));
   if (frames <= 0) return;
   // The block stands for the buffer period that ended now: [now − P, now).
@@ -62,8 +66,8 @@ void Player::render(float* interleaved, int frames, std::int64_t nowNs) noexcept
   guard_.store(synth_.guardEvents(), std::memory_order_relaxed);
 }
 
-// Near the deadline the limit drops by one (the synth fades the released keys first, oldest
-// first); after a second under kRelief it rises by one, back to the preset's polyphony.
+// Near the deadline the limit drops by one (the synth fades the keys furthest below their own
+// peak first); after a second under kRelief it rises by one, back to the preset's polyphony.
 void Player::protect(double load, double blockSeconds) noexcept {
   if (load > kOverload && limit_ > 1) {
     limit_ = std::max(1, std::min(limit_, synth_.activeVoices()) - 1);
@@ -77,6 +81,11 @@ void Player::protect(double load, double blockSeconds) noexcept {
     }
   }
   limitShown_.store(limit_, std::memory_order_relaxed);
+}
+
+std::optional<pthread_t> Player::callbackThread() const {
+  if (!callbackKnown_.load(std::memory_order_acquire)) return std::nullopt;
+  return callbackThread_;
 }
 
 Player::Status Player::status() const {

@@ -1,21 +1,19 @@
 // The audio callback's work, apart from any audio API (so it can be tested and sanitised alone):
 // MIDI from the queue placed on the block's samples, the synthesizer, the recording tee, the load
 // measurement and the overload protection. Real-time safe: no allocation, lock, I/O or syscall
-// beyond reading the steady clock.
+// beyond reading the steady clock and waking the synthesizer's sleeping workers (sem_post).
 #pragma once
+
+#include <pthread.h>
 
 #include <atomic>
 #include <cstdint>
+#include <optional>
 
 #include "midi_input.h"
+#include "synth/nonblocking.h"
 #include "synth/spsc_queue.h"
 #include "synth/synth.h"
-
-#if defined(__clang__) && __clang_major__ >= 20
-#define HAMILTONE_NONBLOCKING [[clang::nonblocking]]
-#else
-#define HAMILTONE_NONBLOCKING
-#endif
 
 namespace hamiltone::app {
 
@@ -36,12 +34,16 @@ class Player {
 
   struct Status {
     int voices = 0, limit = 0, guardEvents = 0;
-    double load = 0.0, peakLoad = 0.0;  // compute time / buffer period
-    long recordDropped = 0;             // samples the recording ring had no room for
-    long late = 0;                      // blocks whose compute time exceeded their period
-    std::uint32_t lastMessage = 0;      // status << 16 | data1 << 8 | data2; 0 before any
+    // The callback's time from its start until the last key is rendered, on whichever thread
+    // (Synth::process returns only then), over the buffer period: what the deadline sees.
+    double load = 0.0, peakLoad = 0.0;
+    long recordDropped = 0;         // samples the recording ring had no room for
+    long late = 0;                  // blocks whose compute time exceeded their period
+    std::uint32_t lastMessage = 0;  // status << 16 | data1 << 8 | data2; 0 before any
   };
   Status status() const;  // from any thread
+  // The thread that ran the first render(), once there was one: the audio API's callback thread.
+  std::optional<pthread_t> callbackThread() const;  // from any thread
 
  private:
   void protect(double load, double blockSeconds) noexcept;
@@ -58,6 +60,8 @@ class Player {
   std::atomic<double> load_{0.0}, peak_{0.0};
   std::atomic<long> recordDropped_{0}, late_{0};
   std::atomic<std::uint32_t> last_{0};
+  pthread_t callbackThread_{};  // written once, before callbackKnown_
+  std::atomic<bool> callbackKnown_{false};
 };
 
 }  // namespace hamiltone::app

@@ -1,9 +1,15 @@
 // Cost of the live player's audio callback: Player::render — the MIDI drained onto the block, the
-// synthesizer, the interleave — timed call by call with N grand-piano keys held (C3 upward,
-// re-struck every 2 s) at 128 and 256 frames: the mean, the 99.9th percentile and the maximum per
-// buffer, in ms and as a share of the buffer period. Then, per buffer size, the fewest keys at
-// which the 99.9th percentile reaches 70 % of the period: what one core can promise with headroom
-// left for the audio server and the rest of the system.
+// synthesizer, the interleave — timed call by call, as a share of the buffer period.
+//
+// On one core (the keys on the callback's thread alone): N grand-piano keys held (C3 upward,
+// re-struck every 2 s) at 128 and 256 frames — the mean, the percentiles and the maximum per
+// buffer — and, per buffer size, the fewest keys at which the 99.9th percentile reaches 70 % of
+// the period: what one core can promise with headroom left for the audio server and the rest.
+//
+// On the worker pool (2 threads, or --threads=N): chords of 8 to 32 grand-piano keys spread evenly
+// from A0 to C8, the pedal down and the chord struck again every 0.5 s, at 64, 128 and 256 frames;
+// at the end a table of the 50th, 99th and 99.9th percentiles and the maximum per buffer size and
+// chord. The callback's time includes the workers': Synth::process returns when every key is done.
 //
 // --blocks=N sets the buffers timed per run (default 1000, the fewest a 99.9th percentile needs).
 #include <benchmark/benchmark.h>
@@ -28,37 +34,71 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 constexpr double kSampleRate = 48000.0;
-constexpr int kLowestKey = 48;      // C3: keys C3, C#3, … upward, the middle register
-constexpr double kRestrikeS = 2.0;  // well inside the keys' T60s: every key keeps sounding
-constexpr double kBudget = 0.7;     // of the buffer period
+constexpr int kLowestKey = 48;   // C3: keys C3, C#3, … upward, the middle register
+constexpr double kBudget = 0.7;  // of the buffer period
 constexpr int kMaxVoices = 32;
 constexpr int kBufferSizes[] = {128, 256};
 constexpr int kVoiceCounts[] = {8, 16, 32};
+constexpr int kPoolBufferSizes[] = {64, 128, 256};
+constexpr int kChordSizes[] = {8, 16, 24, 32};
 // The Player is told a rate this many times lower than the synth's. Its overload guard (fewer
 // voices above 80 % of the period) then never engages, so the keys asked for are the keys timed;
 // the MIDI offsets come from the same rate and clock, so they are unchanged.
 constexpr double kGuardOff = 1000.0;
 
 int blocks = 1000;
+int poolThreads = 2;
 
 const Instrument& piano() {
   static const Instrument instrument = loadPreset(HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml");
   return instrument;
 }
 
-// A Player around a synth that holds `voices` keys from C3, struck by MIDI at the first buffer
-// and every 2 s of audio after it, as a keyboard would through the player's queue.
+// What the keyboard plays: these keys, struck together at the first buffer and every `restrikeS`
+// of audio after it, with the pedal down or not, on a synth of `threads` threads.
+struct Playing {
+  std::vector<int> keys;
+  double restrikeS = 2.0;
+  bool pedal = false;
+  int threads = 1;
+};
+
+// `count` keys from C3 upward, held and struck every 2 s (well inside their T60s: they keep
+// sounding), on the callback's thread alone.
+Playing fromC3(int count) {
+  Playing p;
+  for (int i = 0; i < count; ++i) p.keys.push_back(kLowestKey + i);
+  return p;
+}
+
+// `count` keys spread evenly from A0 to C8, the pedal down, the chord struck every 0.5 s, on the
+// worker pool.
+Playing acrossTheKeyboard(int count) {
+  Playing p{.keys = {}, .restrikeS = 0.5, .pedal = true, .threads = poolThreads};
+  const Instrument& instrument = piano();
+  const int span = instrument.highestNote - instrument.lowestNote;
+  for (int i = 0; i < count; ++i)
+    p.keys.push_back(instrument.lowestNote +
+                     static_cast<int>(std::lround(static_cast<double>(i) * span / (count - 1))));
+  return p;
+}
+
+// A Player around a synth that plays `playing` by MIDI through the player's queue, as a keyboard
+// would.
 class Rig {
  public:
-  Rig(int voices, int frames)
-      : voices_(voices),
+  Rig(const Playing& playing, int frames)
+      : playing_(playing),
         frames_(frames),
-        restrike_(static_cast<long>(kRestrikeS * kSampleRate / frames)),
+        restrike_(std::max(1L, std::lround(playing.restrikeS * kSampleRate / frames))),
         out_(2 * static_cast<size_t>(frames)) {
     std::vector<bool> notes(128, false);
-    for (int i = 0; i < voices; ++i) notes[kLowestKey + i] = true;
-    synth_.prepare({piano()}, {.sampleRate = kSampleRate, .maxBlock = frames, .notes = notes});
-    synth_.setPolyphony(voices);
+    for (int key : playing.keys) notes[key] = true;
+    synth_.prepare({piano()}, {.sampleRate = kSampleRate,
+                               .maxBlock = frames,
+                               .notes = notes,
+                               .threads = playing.threads});
+    synth_.setPolyphony(static_cast<int>(playing.keys.size()));
     player_ =
         std::make_unique<app::Player>(synth_, midi_, nullptr, kSampleRate / kGuardOff, frames);
   }
@@ -67,10 +107,11 @@ class Rig {
   double render() {
     const double period = frames_ / (kSampleRate / kGuardOff);
     const std::int64_t nowNs = std::llround((block_ + 1) * period * 1e9);
-    if (block_++ % restrike_ == 0)  // arrived a period ago: at the block's first sample
-      for (int i = 0; i < voices_; ++i)
-        midi_.push({nowNs - std::llround(period * 1e9),
-                    {0x90, static_cast<std::uint8_t>(kLowestKey + i), 90}});
+    const std::int64_t arrival = nowNs - std::llround(period * 1e9);  // the block's first sample
+    if (block_ == 0 && playing_.pedal) midi_.push({arrival, {0xB0, 64, 127}});
+    if (block_++ % restrike_ == 0)
+      for (int key : playing_.keys)
+        midi_.push({arrival, {0x90, static_cast<std::uint8_t>(key), 90}});
     const Clock::time_point start = Clock::now();
     player_->render(out_.data(), frames_, nowNs);
     const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
@@ -78,10 +119,13 @@ class Rig {
     return seconds;
   }
 
-  int activeVoices() const { return synth_.activeVoices(); }
+  bool allSounding() const {
+    return synth_.activeVoices() == static_cast<int>(playing_.keys.size());
+  }
 
  private:
-  int voices_, frames_;
+  Playing playing_;
+  int frames_;
   long restrike_, block_ = 0;
   Synth synth_;
   SpscQueue<app::StampedMessage> midi_{app::MidiInput::kQueueSize};
@@ -90,40 +134,47 @@ class Rig {
 };
 
 struct Timing {
-  double mean = 0.0, p999 = 0.0, max = 0.0;  // seconds per buffer
+  double mean = 0.0, p50 = 0.0, p99 = 0.0, p999 = 0.0, max = 0.0;  // seconds per buffer
 };
 
-// The nearest-rank 99.9th percentile: with 1000 calls, the second slowest.
+// Nearest-rank percentiles: with 1000 calls the 99.9th is the second slowest.
 Timing summarize(std::vector<double> seconds) {
   std::sort(seconds.begin(), seconds.end());
+  auto percentile = [&](double p) {
+    const size_t rank = static_cast<size_t>(std::ceil(p * static_cast<double>(seconds.size())));
+    return seconds[std::max<size_t>(rank, 1) - 1];
+  };
   Timing t;
   for (double s : seconds) t.mean += s / static_cast<double>(seconds.size());
-  const size_t rank = static_cast<size_t>(std::ceil(0.999 * static_cast<double>(seconds.size())));
-  t.p999 = seconds[std::max<size_t>(rank, 1) - 1];
+  t.p50 = percentile(0.5);
+  t.p99 = percentile(0.99);
+  t.p999 = percentile(0.999);
   t.max = seconds.back();
   return t;
 }
 
-Timing timeRig(int voices, int frames) {
-  Rig rig(voices, frames);
+Timing timeRig(const Playing& playing, int frames) {
+  Rig rig(playing, frames);
   std::vector<double> seconds(static_cast<size_t>(blocks));
   for (double& s : seconds) s = rig.render();
   return summarize(std::move(seconds));
 }
 
 // Each iteration is one callback, so the table's time column is the mean per buffer.
-void callback(benchmark::State& state, int voices, int frames) {
-  Rig rig(voices, frames);
+void callback(benchmark::State& state, const Playing& playing, int frames) {
+  Rig rig(playing, frames);
   std::vector<double> seconds(static_cast<size_t>(blocks));
   size_t i = 0;
   for (auto _ : state) seconds[i++] = rig.render();
-  if (rig.activeVoices() != voices) state.SkipWithError("not every key kept sounding");
+  if (!rig.allSounding()) state.SkipWithError("not every key kept sounding");
   const Timing t = summarize(std::move(seconds));
   const double period = frames / kSampleRate;
   state.counters["mean_ms"] = 1e3 * t.mean;
   state.counters["p99.9_ms"] = 1e3 * t.p999;
   state.counters["max_ms"] = 1e3 * t.max;
   state.counters["mean_%"] = 100.0 * t.mean / period;
+  state.counters["p50_%"] = 100.0 * t.p50 / period;
+  state.counters["p99_%"] = 100.0 * t.p99 / period;
   state.counters["p99.9_%"] = 100.0 * t.p999 / period;
   state.counters["max_%"] = 100.0 * t.max / period;
 }
@@ -135,8 +186,35 @@ void budget(benchmark::State& state, int frames) {
   int found = 0;
   for (auto _ : state)
     for (int voices = 1; voices <= kMaxVoices && found == 0; ++voices)
-      if (timeRig(voices, frames).p999 >= kBudget * period) found = voices;
+      if (timeRig(fromC3(voices), frames).p999 >= kBudget * period) found = voices;
   state.counters["voices"] = found;
+}
+
+std::string poolName(int frames, int keys) {
+  return "pool/threads:" + std::to_string(poolThreads) + "/frames:" + std::to_string(frames) +
+         "/keys:" + std::to_string(keys);
+}
+
+// The pool's runs as a Markdown table, for the README.
+void printPoolTable(const RecordingReporter& reporter) {
+  bool header = false;
+  for (int frames : kPoolBufferSizes)
+    for (int keys : kChordSizes) {
+      const auto* r = reporter.find(poolName(frames, keys));
+      if (!r) continue;
+      if (!header) {
+        std::printf(
+            "\ngrand-piano chords spread from A0 to C8, pedal down, struck every 0.5 s, on %d "
+            "thread%s: callback time as %% of the buffer period (%d buffers per run)\n\n"
+            "| keys | frames | p50 | p99 | p99.9 | max |\n|---:|---:|---:|---:|---:|---:|\n",
+            poolThreads, poolThreads == 1 ? "" : "s", blocks);
+        header = true;
+      }
+      const auto& c = r->counters;
+      std::printf("| %d | %d | %.0f %% | %.0f %% | %.0f %% | %.0f %% |\n", keys, frames,
+                  c.at("p50_%").value, c.at("p99_%").value, c.at("p99.9_%").value,
+                  c.at("max_%").value);
+    }
 }
 
 }  // namespace
@@ -149,6 +227,8 @@ int main(int argc, char** argv) {
     const std::string arg = argv[i];
     if (arg.rfind("--blocks=", 0) == 0)
       blocks = std::max(1, std::atoi(arg.c_str() + 9));
+    else if (arg.rfind("--threads=", 0) == 0)
+      poolThreads = std::clamp(std::atoi(arg.c_str() + 10), 1, Synth::kMaxThreads);
     else
       args.push_back(argv[i]);
   }
@@ -161,7 +241,7 @@ int main(int argc, char** argv) {
       benchmark::RegisterBenchmark(
           ("callback/frames:" + std::to_string(frames) + "/voices:" + std::to_string(voices))
               .c_str(),
-          [voices, frames](benchmark::State& s) { callback(s, voices, frames); })
+          [voices, frames](benchmark::State& s) { callback(s, fromC3(voices), frames); })
           ->Iterations(blocks)
           ->Unit(benchmark::kMillisecond);
   for (int frames : kBufferSizes)
@@ -169,6 +249,13 @@ int main(int argc, char** argv) {
                                  [frames](benchmark::State& s) { budget(s, frames); })
         ->Iterations(1)
         ->Unit(benchmark::kSecond);
+  for (int frames : kPoolBufferSizes)
+    for (int keys : kChordSizes)
+      benchmark::RegisterBenchmark(
+          poolName(frames, keys).c_str(),
+          [keys, frames](benchmark::State& s) { callback(s, acrossTheKeyboard(keys), frames); })
+          ->Iterations(blocks)
+          ->Unit(benchmark::kMillisecond);
 
   RecordingReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
@@ -188,5 +275,6 @@ int main(int argc, char** argv) {
           "to %d keys\n",
           frames, 1e3 * frames / kSampleRate, kMaxVoices);
   }
+  printPoolTable(reporter);
   benchmark::Shutdown();
 }

@@ -1,8 +1,9 @@
 // Cost of the synthesizer playing the grand-piano preset: chords of N held middle-register keys
 // (every unison string of each key), as a real-time callback would ask for them. The counter
 // "x_realtime" is seconds of audio per second of CPU: above 1 the chord plays in real time on one
-// core. The summary names the largest N that does. Beside it, the cost of one grand-piano key
-// across the keyboard on each string grid rule, and the ratio of the two-grid to the transverse.
+// core (threads = 1: every key on the calling thread). The summary names the largest N that does.
+// Beside it, the cost of one grand-piano key across the keyboard on each string grid rule, and the
+// ratio of the two-grid to the transverse.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -18,7 +19,7 @@ namespace hamiltone {
 namespace {
 
 constexpr double kSampleRate = 48000.0;
-constexpr int kLowestKey = 48;  // C3: keys C3, C#3, … upward, the middle register
+constexpr int kLowestKey = 48;      // C3: keys C3, C#3, … upward, the middle register
 constexpr double kRestrikeS = 2.0;  // keys are struck again every 2 s, well inside their T60s
 
 void chord(benchmark::State& state) {
@@ -28,7 +29,8 @@ void chord(benchmark::State& state) {
   std::vector<bool> notes(128, false);
   for (int i = 0; i < voices; ++i) notes[kLowestKey + i] = true;
   Synth synth;
-  synth.prepare({piano}, {.sampleRate = kSampleRate, .maxBlock = block, .notes = notes});
+  synth.prepare({piano},
+                {.sampleRate = kSampleRate, .maxBlock = block, .notes = notes, .threads = 1});
   synth.setPolyphony(voices);
   std::vector<SynthEvent> strike;
   for (int i = 0; i < voices; ++i)
@@ -38,13 +40,13 @@ void chord(benchmark::State& state) {
   int blocks = 0;
   for (auto _ : state) {
     const bool now = blocks++ % restrike == 0;
-    synth.process(left, right, now ? std::span<const SynthEvent>(strike) : std::span<const SynthEvent>());
+    synth.process(left, right,
+                  now ? std::span<const SynthEvent>(strike) : std::span<const SynthEvent>());
     benchmark::DoNotOptimize(left.data());
   }
   if (synth.activeVoices() != voices) state.SkipWithError("not every key kept sounding");
-  state.counters["x_realtime"] =
-      benchmark::Counter(static_cast<double>(state.iterations()) * block / kSampleRate,
-                         benchmark::Counter::kIsRate);
+  state.counters["x_realtime"] = benchmark::Counter(
+      static_cast<double>(state.iterations()) * block / kSampleRate, benchmark::Counter::kIsRate);
   state.counters["strings"] = 0;
   for (int i = 0; i < voices; ++i)
     state.counters["strings"] += piano.keys[kLowestKey + i - piano.lowestNote].unisons;
@@ -67,7 +69,8 @@ void keyboard(benchmark::State& state) {
   }
   const int keys = static_cast<int>(strike.size());
   Synth synth;
-  synth.prepare({piano}, {.sampleRate = kSampleRate, .maxBlock = kBlockSize, .notes = notes});
+  synth.prepare({piano},
+                {.sampleRate = kSampleRate, .maxBlock = kBlockSize, .notes = notes, .threads = 1});
   synth.setPolyphony(keys);
   std::vector<float> left(kBlockSize), right(kBlockSize);
   const int restrike = static_cast<int>(kRestrikeS * kSampleRate / kBlockSize);
@@ -132,11 +135,13 @@ int main(int argc, char** argv) {
   const int largest = reporter.largest;
   auto& cost = reporter.keyCost;
   if (cost.count("two-grid") && cost.count("transverse"))
-    std::printf("\ngrand-piano key, every 6th from A0: two-grid %.0f ns per sample, transverse %.0f "
-                "(ratio %.2f; goal <= 0.7)\n",
-                1e9 * cost["two-grid"], 1e9 * cost["transverse"],
-                cost["two-grid"] / cost["transverse"]);
-  std::printf("\nlargest grand-piano chord (keys from C3) rendered faster than real time on one "
-              "core: %d keys (goal: 32)\n", largest);
+    std::printf(
+        "\ngrand-piano key, every 6th from A0: two-grid %.0f ns per sample, transverse %.0f "
+        "(ratio %.2f; goal <= 0.7)\n",
+        1e9 * cost["two-grid"], 1e9 * cost["transverse"], cost["two-grid"] / cost["transverse"]);
+  std::printf(
+      "\nlargest grand-piano chord (keys from C3) rendered faster than real time on one "
+      "core: %d keys (goal: 32)\n",
+      largest);
   benchmark::Shutdown();
 }

@@ -53,8 +53,11 @@ std::unique_ptr<BuiltSynth> buildSynth(const SynthRecipe& recipe) {
   }
   auto built = std::make_unique<BuiltSynth>();
   built->recipe = recipe;
-  built->synth.prepare(std::move(instruments),
-                       {.sampleRate = recipe.sampleRate, .maxBlock = kMaxBlock, .notes = {}});
+  // The host's audio thread alone renders (threads = 1): hosts spread their plugins over the
+  // cores, and a pool of workers per instance would compete with them.
+  built->synth.prepare(
+      std::move(instruments),
+      {.sampleRate = recipe.sampleRate, .maxBlock = kMaxBlock, .notes = {}, .threads = 1});
   return built;
 }
 

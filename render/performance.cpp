@@ -85,6 +85,8 @@ RenderStats renderPerformance(Synth& synth, const std::vector<TimedMessage>& mes
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   stats.guardEvents = synth.guardEvents();
   stats.nonFinite = synth.nonFiniteSamples();
+  stats.steals = synth.steals();
+  stats.loudestSteal = synth.loudestSteal();
   return stats;
 }
 

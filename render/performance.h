@@ -13,11 +13,13 @@
 namespace hamiltone::cli {
 
 struct RenderStats {
-  double seconds = 0.0;      // of audio written
-  double wallSeconds = 0.0;  // taken
-  int guardEvents = 0;       // voices the guard silenced
-  long nonFinite = 0;        // samples the master replaced
-  float peak = 0.0f;         // largest |sample| written
+  double seconds = 0.0;       // of audio written
+  double wallSeconds = 0.0;   // taken
+  int guardEvents = 0;        // voices the guard silenced
+  long nonFinite = 0;         // samples the master replaced
+  float peak = 0.0f;          // largest |sample| written
+  long steals = 0;            // keys the voice limit took (Synth::steals)
+  double loudestSteal = 0.0;  // the loudest of them under its own peak (Synth::loudestSteal)
 };
 
 // What an unstable render did and why it is refused: per instrument (by its preset file), the

@@ -75,4 +75,18 @@ std::string renderSummary(double renderedSeconds, double wallSeconds) {
   return text;
 }
 
+std::string stealSummary(long steals, double loudestLevel, int limit) {
+  char text[160];
+  if (steals == 0) {
+    std::snprintf(text, sizeof text, "no key stolen at the limit of %d voices", limit);
+    return text;
+  }
+  const double db = loudestLevel > 0.0 ? 20.0 * std::log10(loudestLevel) : -INFINITY;
+  std::snprintf(
+      text, sizeof text,
+      "%ld key%s stolen at the limit of %d voices, the loudest at %.1f dB of its own peak", steals,
+      steals == 1 ? "" : "s", limit, db);
+  return text;
+}
+
 }  // namespace hamiltone::cli

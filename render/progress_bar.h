@@ -38,4 +38,8 @@ class ProgressBar {
 // A wall time of 0 (below the clock's resolution) or no audio leaves the factor out.
 std::string renderSummary(double renderedSeconds, double wallSeconds);
 
+// "3 keys stolen at the limit of 64 voices, the loudest at -63.2 dB of its own peak", or "no key
+// stolen at the limit of 64 voices". `loudestLevel` is Synth::loudestSteal() (1 is the peak).
+std::string stealSummary(long steals, double loudestLevel, int limit);
+
 }  // namespace hamiltone::cli

@@ -28,7 +28,7 @@ namespace {
 struct RenderArguments {
   std::vector<std::string> presets, sets;
   std::string midi, notes, out, format = "pcm24";
-  std::string sampleRate = "48000", tail = "3", voices, block = "256";
+  std::string sampleRate = "48000", tail = "3", voices, block = "256", threads;
   bool quiet = false, listParams = false;
 };
 
@@ -68,6 +68,10 @@ int run(const RenderArguments& a) {
   const int block = static_cast<int>(parseInteger("--block", a.block, 1, 8192));
   const int voices =
       a.voices.empty() ? 0 : static_cast<int>(parseInteger("--voices", a.voices, 1, 128));
+  const int threads =
+      a.threads.empty()
+          ? 0
+          : static_cast<int>(parseInteger("--threads", a.threads, 1, Synth::kMaxThreads));
 
   // Everything is read and checked before the output file is created.
   std::vector<Instrument> instruments = loadPresets(presets, a.sets);
@@ -112,8 +116,9 @@ int run(const RenderArguments& a) {
 
   Synth synth;
   try {
-    synth.prepare(std::move(instruments),
-                  {.sampleRate = rate, .maxBlock = block, .notes = std::move(notes)});
+    synth.prepare(
+        std::move(instruments),
+        {.sampleRate = rate, .maxBlock = block, .notes = std::move(notes), .threads = threads});
   } catch (const std::invalid_argument& e) {
     throw UsageError(std::string("preset does not build at this sample rate: ") + e.what());
   }
@@ -132,6 +137,8 @@ int run(const RenderArguments& a) {
   if (!a.quiet) {
     std::fprintf(stderr, "hamiltone-render: %s: %s\n", a.out.c_str(),
                  renderSummary(stats.seconds, stats.wallSeconds).c_str());
+    std::fprintf(stderr, "hamiltone-render: %s\n",
+                 stealSummary(stats.steals, stats.loudestSteal, synth.polyphony()).c_str());
   }
   return 0;
 }
@@ -170,6 +177,9 @@ int main(int argc, char** argv) {
   addNumberOption(&app, "--tail", a.tail, "SECONDS", "rendered after the last event, 0 … 600");
   addNumberOption(&app, "--voices", a.voices, "N", "polyphony, 1 … 128 (default: the preset's)");
   addNumberOption(&app, "--block", a.block, "FRAMES", "processing block, 1 … 8192");
+  addNumberOption(&app, "--threads", a.threads, "N",
+                  "threads rendering the keys, 1 … 256 (default: one per core); the file is the "
+                  "same, bit for bit, whatever N");
   app.add_flag("--quiet", a.quiet, "no progress bar and no summary");
   app.add_flag("--list-params", a.listParams,
                "print every preset parameter (name, type, unit, range, default) and exit");

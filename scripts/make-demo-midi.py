@@ -12,18 +12,15 @@ channel messages share a status byte (running status), so the file exercises wha
 Every note is within MIDI 36-96. Python 3 standard library only.
 """
 
-import argparse
-import pathlib
 import struct
 
-from smf import chunk, variable_length
+from smf import (CONTROLLER, NOTE_OFF, NOTE_ON, PROGRAM, SUSTAIN, chunk, meta, track_chunk,
+                 write_file)
 
 DIVISION = 480  # ticks per quarter note
 BAR = 4 * DIVISION
 LEGATO = 0.95  # a note sounds for this fraction of its written length
 CHANNEL = 0
-NOTE_OFF, NOTE_ON, CONTROLLER, PROGRAM = 0x80, 0x90, 0xB0, 0xC0
-SUSTAIN = 64
 
 # (bass, chord) for each bar.
 HARMONY = [
@@ -56,30 +53,6 @@ def dynamics(beat):
     if beat <= 18:
         return round(40 + (120 - 40) * beat / 18)
     return round(120 - (120 - 30) * (beat - 18) / 14)
-
-
-def meta(kind, data):
-    return bytes([0xFF, kind]) + variable_length(len(data)) + data
-
-
-def track_chunk(events):
-    """An MTrk chunk from (tick, order, event bytes), sorted by tick then order. A channel
-    message whose status repeats the previous one is written without it (running status); a
-    meta event ends the run, as the SMF specification asks, so strict readers agree."""
-    body = bytearray()
-    now, running = 0, None
-    for tick, _, event in sorted(events, key=lambda e: (e[0], e[1])):
-        body += variable_length(tick - now)
-        now = tick
-        if event[0] == 0xFF:
-            running = None
-            body += event
-        elif event[0] == running:
-            body += event[1:]
-        else:
-            running = event[0]
-            body += event
-    return chunk(b"MTrk", bytes(body))
 
 
 def tempo_track(end):
@@ -123,13 +96,7 @@ def demo():
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    default = pathlib.Path(__file__).resolve().parent.parent / "presets" / "demo.mid"
-    parser.add_argument("path", nargs="?", default=default, type=pathlib.Path,
-                        help="the file to write (default: presets/demo.mid in the repository)")
-    path = parser.parse_args().path
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_bytes(demo())
+    write_file(__doc__, "demo.mid", demo())
 
 
 if __name__ == "__main__":

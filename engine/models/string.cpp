@@ -20,30 +20,6 @@ void requirePositive(const char* name, double value, const char* unit) {
                                 ": must be a finite number > 0 (" + unit + ")");
 }
 
-// out_j = c (a_{j−1} − 2 a_j + a_{j+1}) / h² on j = 0 … n−1, a = 0 beyond both ends: c D2 a.
-void secondDifference(const double* a, double* out, Eigen::Index n, double c) {
-  if (n == 1) {
-    out[0] = -2.0 * c * a[0];
-    return;
-  }
-  out[0] = c * (a[1] - 2.0 * a[0]);
-  for (Eigen::Index j = 1; j + 1 < n; ++j) out[j] = c * (a[j - 1] - 2.0 * a[j] + a[j + 1]);
-  out[n - 1] = c * (a[n - 2] - 2.0 * a[n - 1]);
-}
-
-// c D2 (a − b) in one pass, the difference taken as it is read; `out` aliases neither.
-void secondDifferenceOfDifference(const double* a, const double* b, double* out, Eigen::Index n,
-                                  double c) {
-  auto d = [&](Eigen::Index j) { return a[j] - b[j]; };
-  if (n == 1) {
-    out[0] = -2.0 * c * d(0);
-    return;
-  }
-  out[0] = c * (d(1) - 2.0 * d(0));
-  for (Eigen::Index j = 1; j + 1 < n; ++j) out[j] = c * (d(j - 1) - 2.0 * d(j) + d(j + 1));
-  out[n - 1] = c * (d(n - 2) - 2.0 * d(n - 1));
-}
-
 }  // namespace
 
 NonlinearString::NonlinearString(const StringPhysics& p, StringGrid grid)
@@ -75,25 +51,27 @@ NonlinearString::NonlinearString(const StringPhysics& p, StringGrid grid)
   inverseMass_.tail(nv).setConstant(1.0 / (p.linearDensity() * hv_));
   for (Vector* w : {&work1_, &work2_}) w->setZero(grid.transverse);
   work3_.setZero(grid.transverse + 1);
-  for (Vector* w : {&cell1_, &cell2_}) w->setZero(grid.longitudinal);
+  for (Vector* w : {&cell1_, &cell2_, &cell3_}) w->setZero(grid.longitudinal);
+  scratch_.setZero(4 * grid.transverse);
 }
 
 void NonlinearString::applyStiffness(const Vector& q, Vector& out) const {
   const Eigen::Index n = segments_ - 1, nv = grid_.longitudinal - 1;
   const double invH2 = 1.0 / (h_ * h_);
   if (nv > 0)
-    secondDifference(q.data() + n, out.data() + n, nv, -physics_.tension / hv_);  // −T0 h_v D2 v
+    kernels_->secondDifference(q.data() + n, out.data() + n, nv,
+                               -physics_.tension / hv_);  // −T0 h_v D2 v
   const double t = tensionScale_ * physics_.tension * h_;
   if (physics_.inertia == 0.0) {
-    secondDifference(q.data(), out.data(), n, -t * invH2);  // −βT0 h D2 u
+    kernels_->secondDifference(q.data(), out.data(), n, -t * invH2);  // −βT0 h D2 u
     return;
   }
   // h (−βT0 D2 + EI D2²) u. D2² with D2 u = 0 at the ends is the simply supported biharmonic.
   const double ei = physics_.young * physics_.inertia * h_;
   double* d2u = work1_.data();
   double* d4u = work2_.data();
-  secondDifference(q.data(), d2u, n, invH2);
-  secondDifference(d2u, d4u, n, invH2);
+  kernels_->secondDifference(q.data(), d2u, n, invH2);
+  kernels_->secondDifference(d2u, d4u, n, invH2);
   for (Eigen::Index j = 0; j < n; ++j) out[j] = -t * d2u[j] + ei * d4u[j];
 }
 
@@ -136,9 +114,10 @@ void NonlinearString::applyLossOperator(const Vector& a, const Vector& b, Vector
   const Eigen::Index nu = segments_ - 1, nv = grid_.longitudinal - 1;
   // M (−D2) = −ρA h D2 on each grid, with its own h.
   const double rhoA = physics_.linearDensity();
-  secondDifferenceOfDifference(a.data(), b.data(), out.data(), nu, -rhoA / h_);
+  kernels_->secondDifferenceOfDifference(a.data(), b.data(), out.data(), nu, -rhoA / h_);
   if (nv > 0)
-    secondDifferenceOfDifference(a.data() + nu, b.data() + nu, out.data() + nu, nv, -rhoA / hv_);
+    kernels_->secondDifferenceOfDifference(a.data() + nu, b.data() + nu, out.data() + nu, nv,
+                                           -rhoA / hv_);
 }
 
 namespace {
@@ -181,38 +160,6 @@ double NonlinearString::singleGridPotential(const Vector& q) const {
   return 0.5 * h_ * (physics_.young * physics_.area - physics_.tension) * sum;
 }
 
-// ∂V'/∂ζ_l = c φ_l ζ_l, ∂V'/∂η_l = c φ_l (1 + η_l), c = h (EA − T0); then
-// ∇_u V' = D₋ᵀ(∂V'/∂ζ): (D₋ᵀ w)_j = (w_j − w_{j+1}) / h, likewise for v.
-double NonlinearString::singleGridGradient(const Vector& q, Vector& grad) const {
-  const Eigen::Index m = segments_;
-  const double* u = q.data();
-  const double* v = q.data() + (m - 1);
-  const double invH = 1.0 / h_;
-  const double c = h_ * (physics_.young * physics_.area - physics_.tension);
-  double* wz = work1_.data();
-  double* we = work2_.data();
-  auto segment = [&](Eigen::Index l, double zeta, double eta) {
-    double phi;
-    const double e = segmentExcess(zeta, eta, phi);
-    wz[l] = c * phi * zeta;
-    we[l] = c * phi * (1.0 + eta);
-    return e;
-  };
-  double sum =
-      segment(0, u[0] * invH, v[0] * invH) + segment(m - 1, -u[m - 2] * invH, -v[m - 2] * invH);
-#pragma omp simd reduction(+ : sum)
-  for (Eigen::Index l = 1; l < m - 1; ++l)
-    sum += segment(l, (u[l] - u[l - 1]) * invH, (v[l] - v[l - 1]) * invH);
-  double* gu = grad.data();
-  double* gv = grad.data() + (m - 1);
-#pragma omp simd
-  for (Eigen::Index j = 0; j < m - 1; ++j) {
-    gu[j] = (wz[j] - wz[j + 1]) * invH;
-    gv[j] = (we[j] - we[j + 1]) * invH;
-  }
-  return 0.5 * c * sum;
-}
-
 namespace {
 
 // η_J = (v_J − v_{J−1}) / h_v on the Mv coarse cells, v = 0 beyond both ends.
@@ -226,50 +173,46 @@ void longitudinalStrains(const double* v, Eigen::Index mv, double invHv, double*
   for (Eigen::Index j = 1; j < mv - 1; ++j) eta[j] = (v[j] - v[j - 1]) * invHv;
 }
 
-// u with its fixed ends, up[0] = up[M] = 0, so that ζ_l = (up[l+1] − up[l]) / h on every segment.
-void paddedTransverse(const double* u, Eigen::Index m, double* up) {
+// u (or v) with its fixed ends, up[0] = up[M] = 0, so that ζ_l = (up[l+1] − up[l]) / h on every
+// segment.
+void padded(const double* u, Eigen::Index m, double* up) {
   up[0] = up[m] = 0.0;
   std::copy(u, u + m - 1, up + 1);
 }
 
-// One coarse cell of r fine segments starting at `up` (padded u) with coarse strain η: returns
-// Σ (s_l − 1) and sets Σ 1/s_l, and ζ_l/s_l into `zetaOverS`; s_l = sqrt((1 + η)² + ζ_l²).
-// s − 1 = (2η + η² + ζ²)/(s + 1) has no cancellation at small strain, and one division serves
-// both quotients: t = 1/(s (s + 1)).
-[[gnu::always_inline]] inline double cellStretch(const double* up, double invH, double eta, int r,
-                                                 double* zetaOverS, double& sumInverse) {
-  const double a = (1.0 + eta) * (1.0 + eta), b = 2.0 * eta + eta * eta;
-  double excess = 0.0, inverse = 0.0;
-#pragma omp simd reduction(+ : excess, inverse)
-  for (int i = 0; i < r; ++i) {
-    const double zeta = (up[i + 1] - up[i]) * invH, z2 = zeta * zeta;
-    const double stretch = std::sqrt(a + z2);
-    const double t = 1.0 / (stretch * (stretch + 1.0));
-    const double inv = (stretch + 1.0) * t;
-    excess += (b + z2) * stretch * t;
-    inverse += inv;
-    zetaOverS[i] = zeta * inv;
-  }
-  sumInverse = inverse;
-  return excess;
+}  // namespace
+
+// ∂V'/∂ζ_l = c φ_l ζ_l, ∂V'/∂η_l = c φ_l (1 + η_l), c = h (EA − T0); then
+// ∇_u V' = D₋ᵀ(∂V'/∂ζ): (D₋ᵀ w)_j = (w_j − w_{j+1}) / h, likewise for v.
+double NonlinearString::singleGridGradient(const Vector& q, Vector& grad) const {
+  const Eigen::Index m = segments_;
+  const double c = h_ * (physics_.young * physics_.area - physics_.tension);
+  double* up = work3_.data();
+  double* vp = scratch_.data();
+  padded(q.data(), m, up);
+  padded(q.data() + (m - 1), m, vp);
+  const double sum = kernels_->singleGridForces(up, vp, m, 1.0 / h_, c, work1_.data(),
+                                                work2_.data(), grad.data(), grad.data() + (m - 1));
+  return 0.5 * c * sum;
 }
 
-}  // namespace
+// ε_J = (1/r) Σ_{l∈J} (s_l − 1) into strain_J and Σ_{l∈J} 1/s_l into sumInverse_J, with ζ_l/s_l
+// into zetaOverS (SCHEMES §3b).
+void NonlinearString::cellStrains(const Vector& q, double* strain, double* sumInverse,
+                                  double* zetaOverS) const {
+  const Eigen::Index m = segments_, mv = grid_.longitudinal;
+  padded(q.data(), m, work3_.data());
+  longitudinalStrains(q.data() + (m - 1), mv, 1.0 / hv_, cell1_.data());
+  kernels_->cellStretches(work3_.data(), cell1_.data(), mv, ratio_, 1.0 / h_, scratch_.data(),
+                          zetaOverS, strain, sumInverse);
+}
 
 // SCHEMES §3b: ε_J = (1/r) Σ_{l∈J} (s_l − 1), V' = (EA − T0)/2 Σ_J h_v ε_J².
 double NonlinearString::twoGridPotential(const Vector& q) const {
-  const Eigen::Index m = segments_, mv = grid_.longitudinal;
-  double* up = work3_.data();
-  double* eta = cell1_.data();
-  const double invR = 1.0 / ratio_;
-  paddedTransverse(q.data(), m, up);
-  longitudinalStrains(q.data() + (m - 1), mv, 1.0 / hv_, eta);
-  double sum = 0.0, unused;
-  for (Eigen::Index j = 0; j < mv; ++j) {
-    const double strain =
-        cellStretch(up + j * ratio_, 1.0 / h_, eta[j], ratio_, work1_.data(), unused) * invR;
-    sum += strain * strain;
-  }
+  double* strain = cell2_.data();
+  cellStrains(q, strain, cell3_.data(), work1_.data());
+  double sum = 0.0;
+  for (Eigen::Index j = 0; j < grid_.longitudinal; ++j) sum += strain[j] * strain[j];
   return 0.5 * hv_ * (physics_.young * physics_.area - physics_.tension) * sum;
 }
 
@@ -278,30 +221,20 @@ double NonlinearString::twoGridPotential(const Vector& q) const {
 // then ∇_u V' = D₋ᵀ(∂V'/∂ζ) on the fine grid and ∇_v V' = D₋ᵀ(∂V'/∂η) on the coarse one.
 double NonlinearString::twoGridGradient(const Vector& q, Vector& grad) const {
   const Eigen::Index m = segments_, mv = grid_.longitudinal;
-  const double invH = 1.0 / h_, invHv = 1.0 / hv_;
-  const double c = (physics_.young * physics_.area - physics_.tension) * h_, invR = 1.0 / ratio_;
-  double* wz = work1_.data();  // ζ_l/s_l, then ∂V'/∂ζ_l
-  double* up = work3_.data();
-  double* eta = cell1_.data();
-  double* we = cell2_.data();  // ∂V'/∂η_J
-  paddedTransverse(q.data(), m, up);
-  longitudinalStrains(q.data() + (m - 1), mv, invHv, eta);
+  const double c = (physics_.young * physics_.area - physics_.tension) * h_;
+  double* zetaOverS = work1_.data();
+  double* strain = cell2_.data();
+  double* we = cell3_.data();  // Σ 1/s_l, then ∂V'/∂η_J
+  cellStrains(q, strain, we, zetaOverS);
+  const double* eta = cell1_.data();
   double sum = 0.0;
   for (Eigen::Index j = 0; j < mv; ++j) {
-    double* cell = wz + j * ratio_;
-    double sumInverse;
-    const double strain =
-        cellStretch(up + j * ratio_, invH, eta[j], ratio_, cell, sumInverse) * invR;
-    sum += strain * strain;
-    const double w = c * strain;
-    we[j] = w * (1.0 + eta[j]) * sumInverse;
-#pragma omp simd
-    for (int i = 0; i < ratio_; ++i) cell[i] *= w;
+    sum += strain[j] * strain[j];
+    we[j] *= c * strain[j] * (1.0 + eta[j]);
   }
-  double* gu = grad.data();
+  kernels_->fineForces(mv, ratio_, c, 1.0 / h_, strain, scratch_.data(), zetaOverS, grad.data());
   double* gv = grad.data() + (m - 1);
-#pragma omp simd
-  for (Eigen::Index j = 0; j < m - 1; ++j) gu[j] = (wz[j] - wz[j + 1]) * invH;
+  const double invHv = 1.0 / hv_;
   for (Eigen::Index j = 0; j < mv - 1; ++j) gv[j] = (we[j] - we[j + 1]) * invHv;
   return 0.5 * hv_ * (physics_.young * physics_.area - physics_.tension) * sum;
 }

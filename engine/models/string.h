@@ -6,6 +6,7 @@
 
 #include <algorithm>
 
+#include "kernels/kernels.h"
 #include "schemes/hamiltonian.h"
 
 namespace hamiltone {
@@ -70,6 +71,8 @@ class NonlinearString {
   // as a tuning peg's small stretch leaves EA − T0 unchanged). stiffnessEigenvalueMax() answers for
   // the largest β allowed, so a scheme built after setTensionRange() stays stable for any bend.
   void setTensionRange(double maxScale);  // >= 1; resets β to 1
+  // The instruction set of the stencils and the stretches (default: selectedKernels()).
+  void setKernels(const Kernels& kernels) noexcept { kernels_ = &kernels; }
   void setTensionScale(double scale) { tensionScale_ = std::clamp(scale, 0.0, tensionScaleMax_); }
   double tensionScale() const { return tensionScale_; }
 
@@ -84,6 +87,7 @@ class NonlinearString {
   double singleGridGradient(const Vector& q, Vector& grad) const;
   double twoGridPotential(const Vector& q) const;
   double twoGridGradient(const Vector& q, Vector& grad) const;
+  void cellStrains(const Vector& q, double* strain, double* sumInverse, double* zetaOverS) const;
 
   StringPhysics physics_;
   StringGrid grid_;
@@ -92,8 +96,10 @@ class NonlinearString {
   Vector inverseMass_;
   double tensionScale_ = 1.0, tensionScaleMax_ = 1.0;
   // Work of the stencils and the gradient: per fine segment (size Mu; work3_ holds u padded with
-  // its fixed ends, Mu + 1) and per coarse cell (Mv).
-  mutable Vector work1_, work2_, work3_, cell1_, cell2_;
+  // its fixed ends, Mu + 1; scratch_ the two-grid kernels', 4 Mu) and per coarse cell (Mv).
+  mutable Vector work1_, work2_, work3_, cell1_, cell2_, cell3_;
+  mutable Vector scratch_;
+  const Kernels* kernels_ = &selectedKernels();
 };
 
 // How the grid spacing h follows from the time step k (BDZ §4.2, SCHEMES §3).

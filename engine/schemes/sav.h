@@ -6,6 +6,7 @@
 #include <cmath>
 #include <utility>
 
+#include "kernels/kernels.h"
 #include "schemes/hamiltonian.h"
 #include "schemes/linear_loss.h"
 #include "schemes/step_parameters.h"
@@ -123,6 +124,9 @@ class SavScheme {
     psi_[part] = std::sqrt(2.0 * (quadratisedPotential(part, next_) + params_.epsilon));
   }
 
+  // The instruction set of the one-part passes (default: selectedKernels()).
+  void setKernels(const Kernels& kernels) noexcept { kernels_ = &kernels; }
+
   long stepIndex() const { return n_; }
   double time() const { return static_cast<double>(n_) * params_.k; }
   const Vector& q() const { return prev_; }
@@ -174,35 +178,36 @@ class SavScheme {
     }
     const bool onePass = parts == 1 || loaded <= 1;
     // The loss's σ1 term and the external force enter b alike, b −= M⁻¹ extra_ with
-    // extra_ = 2σ1k C(q^n − q^{n−1}) − k² f.
+    // extra_ = 2σ1k C(q^n − q^{n−1}) − k² f. Unforced with one part loaded, the kernels scale
+    // C(q^n − q^{n−1}) as they read it (the same products, one pass fewer).
     const double* cq = nullptr;
+    double cqScale = 1.0;
     if constexpr (lossy) {
       const Vector& lossForce = loss_.frequencyForce(system_, curr_, prev_);
-      if (forced_)
+      if (forced_) {
         extra_ = (2.0 * params_.sigma1 * k) * lossForce - kk * force_;
-      else
+        cq = extra_.data();
+      } else if (onePass) {
+        cq = lossForce.data();
+        cqScale = 2.0 * params_.sigma1 * k;
+      } else {
         extra_ = (2.0 * params_.sigma1 * k) * lossForce;
-      cq = extra_.data();
+        cq = extra_.data();
+      }
     }
 
     // Pass 1: ∇V'_jᵀ of q^n, q^{n−1}, M⁻¹K q^n, M⁻¹C(q^n − q^{n−1}), and ∇V'_iᵀ M⁻¹ ∇V'_j.
-    // With one part loaded the sums are scalars, which GCC keeps in registers; array
-    // reductions cost it a third more on the 1000-pair FPU chain.
+    // With one part loaded (a string off its hammer: nearly every step) the passes are the
+    // kernels of the CPU's instruction set (kernels/kernels.h); with several, array reductions.
     double gq[parts] = {}, gqm[parts] = {}, gMKq[parts] = {}, gMCq[parts] = {};  // gMCq: of extra_
     double gMg[parts * parts] = {};
     if (onePass) {
       const int a = onlyLoaded;
-      const double* g0 = g[a];
-      double sq = 0.0, sqm = 0.0, sMKq = 0.0, sMCq = 0.0, sMg = 0.0;
-#pragma omp simd reduction(+ : sq, sqm, sMKq, sMCq, sMg)
-      for (Eigen::Index i = 0; i < n; ++i) {
-        sq += g0[i] * q[i];
-        sqm += g0[i] * qm[i];
-        if constexpr (splitK) sMKq += g0[i] * (minv[i] * kq[i]);
-        if constexpr (lossy) sMCq += g0[i] * (minv[i] * cq[i]);
-        sMg += g0[i] * minv[i] * g0[i];
-      }
-      gq[a] = sq, gqm[a] = sqm, gMKq[a] = sMKq, gMCq[a] = sMCq, gMg[a * parts + a] = sMg;
+      double dots[5];
+      kernels_->savDots(n, g[a], q, qm, minv, splitK ? kq : nullptr, lossy ? cq : nullptr, cqScale,
+                        dots);
+      gq[a] = dots[0], gqm[a] = dots[1], gMKq[a] = dots[2], gMCq[a] = dots[3];
+      gMg[a * parts + a] = dots[4];
     } else {
 #pragma omp simd reduction(+ : gq[:parts], gqm[:parts], gMKq[:parts], gMCq[:parts], \
                                gMg[:parts * parts])
@@ -250,13 +255,8 @@ class SavScheme {
     double gdq[parts] = {};
     if (onePass) {
       const int a = onlyLoaded;
-      const double* g0 = g[a];
-      const double ca = c[a];
-      double sdq = 0.0;
-#pragma omp simd reduction(+ : sdq)
-      for (Eigen::Index i = 0; i < n; ++i)
-        sdq += g0[i] * (newPosition(i, ca * (minv[i] * g0[i])) - qm[i]);
-      gdq[a] = sdq;
+      gdq[a] = kernels_->savUpdate(n, g[a], q, qm, minv, splitK ? kq : nullptr,
+                                   lossy ? cq : nullptr, cqScale, down, kk, c[a], invUp, qp);
     } else {
 #pragma omp simd reduction(+ : gdq[:parts])
       for (Eigen::Index i = 0; i < n; ++i) {
@@ -325,6 +325,7 @@ class SavScheme {
   double supplied_ = 0.0;  // work of f since the start
   double dissipated_ = 0.0;
   long n_ = 0;
+  const Kernels* kernels_ = &selectedKernels();
 };
 
 template <HamiltonianSystem S>

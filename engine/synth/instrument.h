@@ -26,7 +26,7 @@ struct Instrument {
   int lowestNote = 21, highestNote = 108;  // MIDI; notes outside are ignored
   std::vector<StringKey> keys;             // string model: keys[note − lowestNote]
   PlatePatch plate;                        // plate model: PlateVoice sizes it to each note
-  int polyphony = 16;                      // keys sounding at once, at most
+  int polyphony = 64;                      // keys sounding at once, at most
   double gainDb = 0.0;                     // applied to the sum of the voices
   double bendRange = 2.0;                  // semitones each way of the pitch wheel (strings)
   double panSpread = 0.5;                  // 0: all centred; 1: lowest key left … highest right

@@ -6,9 +6,12 @@
 #include <cmath>
 #include <numbers>
 
+#include "voices/voice_block.h"
+
 namespace hamiltone {
 
-void KeyVoice::prepare(const Instrument& instrument, int note, double sampleRate, int maxBlock) {
+void KeyVoice::prepare(const Instrument& instrument, int note, double sampleRate, int maxBlock,
+                       bool freeQuiet) {
   std::vector<StringVoice> strings;
   std::unique_ptr<PlateVoice> plate;
   if (instrument.model == InstrumentModel::string) {
@@ -28,8 +31,17 @@ void KeyVoice::prepare(const Instrument& instrument, int note, double sampleRate
   plate_ = std::move(plate);
   panLeft_ = std::numbers::sqrt2 * std::cos(angle);
   panRight_ = std::numbers::sqrt2 * std::sin(angle);
-  for (auto* buffer : {&voiceLeft_, &voiceRight_, &mixLeft_, &mixRight_})
+  // A voice is silent under QuietDetector::kFloor of full scale at the instrument's output: in
+  // its own units, divided by the instrument's gain and the louder side's pan, and shared among
+  // the key's strings so that all of them together stay under it.
+  const double heard = std::pow(10.0, instrument.gainDb / 20.0) * std::max(panLeft_, panRight_) *
+                       static_cast<double>(std::max<size_t>(strings_.size(), 1));
+  const double floor = freeQuiet ? QuietDetector::kFloor / heard : -1.0;
+  for (StringVoice& s : strings_) s.setQuietFloor(floor);
+  if (plate_) plate_->setQuietFloor(floor);
+  for (auto* buffer : {&voiceLeft_, &voiceRight_, &mixLeft_, &mixRight_, &outLeft_, &outRight_})
     buffer->assign(maxBlock, 0.0f);
+  frames_ = 0;
   fadeSamples_ = std::max(1, static_cast<int>(std::lround(kFadeS * sampleRate)));
   envelopeDecay_ = std::exp(-1.0 / (kEnvelopeS * sampleRate));
   attackSamples_ = std::lround(kEnvelopeS * sampleRate);
@@ -37,7 +49,7 @@ void KeyVoice::prepare(const Instrument& instrument, int note, double sampleRate
   fadeLeft_ = 0;
   pendingVelocity_ = -1.0;
   releasePending_ = false;
-  envelope_ = 0.0;
+  envelope_ = loudest_ = 0.0;
   down = sustained = false;
 }
 
@@ -53,6 +65,7 @@ void KeyVoice::strike(double velocity, long order) noexcept {
 }
 
 void KeyVoice::strikeNow(double velocity) noexcept {
+  loudest_ = envelope_;
   for (StringVoice& s : strings_) s.noteOn(velocity);
   if (plate_) plate_->noteOn(velocity);
 }
@@ -78,6 +91,11 @@ void KeyVoice::setBend(double semitones) noexcept {
   for (StringVoice& s : strings_) s.setBend(semitones);
 }
 
+double KeyVoice::level() const {
+  if (sinceStrike_ < attackSamples_) return 1.0;
+  return loudest_ > 0.0 ? envelope_ / loudest_ : 0.0;
+}
+
 bool KeyVoice::sounding() const {
   for (const StringVoice& s : strings_)
     if (s.active()) return true;
@@ -94,9 +112,11 @@ double KeyVoice::fundamentalHz() const {
   return plate_ ? plate_->lowestModeHz() : strings_.front().fundamentalHz();
 }
 
-void KeyVoice::process(std::span<float> left, std::span<float> right, double gain) noexcept {
+void KeyVoice::process(size_t frames, double gain) noexcept {
+  frames_ = frames;
+  const std::span<float> left(outLeft_.data(), frames), right(outRight_.data(), frames);
   size_t done = 0;
-  while (done < left.size()) {
+  while (done < frames) {
     if (!fading() && pending()) {  // the fade is over (or its voices fell silent): strike
       strikeNow(pendingVelocity_);
       pendingVelocity_ = -1.0;
@@ -104,7 +124,7 @@ void KeyVoice::process(std::span<float> left, std::span<float> right, double gai
       releasePending_ = false;
     }
     const bool wasFading = fading();
-    size_t length = left.size() - done;
+    size_t length = frames - done;
     if (wasFading) length = std::min(length, static_cast<size_t>(fadeLeft_));
     render(left.subspan(done, length), right.subspan(done, length), gain);
     done += length;
@@ -114,6 +134,9 @@ void KeyVoice::process(std::span<float> left, std::span<float> right, double gai
       if (!pending()) break;
     }
   }
+  // A key whose fade ended inside the piece is silent for the rest of it.
+  std::fill(left.begin() + done, left.end(), 0.0f);
+  std::fill(right.begin() + done, right.end(), 0.0f);
 }
 
 void KeyVoice::render(std::span<float> left, std::span<float> right, double gain) noexcept {
@@ -142,10 +165,11 @@ void KeyVoice::render(std::span<float> left, std::span<float> right, double gain
   for (size_t i = 0; i < n; ++i) {
     envelope_ = std::max({static_cast<double>(std::abs(mixL[i])),
                           static_cast<double>(std::abs(mixR[i])), envelope_ * envelopeDecay_});
+    loudest_ = std::max(loudest_, envelope_);
     // Linear to zero: the last faded sample is 0, and each step is at most peak / 240 at 48 kHz.
     const double fade = fadeLeft_ > 0 ? static_cast<double>(--fadeLeft_) / fadeSamples_ : 1.0;
-    left[i] += static_cast<float>(gl * fade * mixL[i]);
-    right[i] += static_cast<float>(gr * fade * mixR[i]);
+    left[i] = static_cast<float>(gl * fade * mixL[i]);
+    right[i] = static_cast<float>(gr * fade * mixR[i]);
   }
 }
 

@@ -2,7 +2,6 @@
 // image, and the key's state — held, sustained by the pedal, released, or fading out when stolen.
 #pragma once
 
-#include <cmath>
 #include <memory>
 #include <span>
 #include <vector>
@@ -16,8 +15,11 @@ class KeyVoice {
   static constexpr double kFadeS = 0.005;     // a stolen or silenced voice fades over 5 ms
   static constexpr double kEnvelopeS = 0.05;  // the loudness follower's release time constant
 
-  // May allocate; throws std::invalid_argument naming the patch field (from the voices).
-  void prepare(const Instrument& instrument, int note, double sampleRate, int maxBlock);
+  // May allocate; throws std::invalid_argument naming the patch field (from the voices). With
+  // freeQuiet false no voice frees itself when it falls silent (QuietDetector): it sounds until
+  // stolen or silenced, the reference the tests of that culling compare against.
+  void prepare(const Instrument& instrument, int note, double sampleRate, int maxBlock,
+               bool freeQuiet);
 
   // 0 … 1. A sounding key is struck again where it is; a fading one is struck once its fade
   // ends, from rest (the note-on is pending until then).
@@ -28,17 +30,22 @@ class KeyVoice {
   void fadeOut() noexcept;  // stolen or silenced: fades over kFadeS, then frees itself
   void setBend(double semitones) noexcept;
 
-  // Adds the key's next left.size() samples, times `gain`, into left and right. Never allocates.
-  void process(std::span<float> left, std::span<float> right, double gain) noexcept;
+  // Writes the key's next `frames` samples (at most maxBlock), times `gain`, into its own output
+  // (left(), right()): the synthesizer sums the keys' outputs in a fixed order, so the mix does not
+  // depend on which thread rendered which key. Touches nothing outside the key. Never allocates.
+  void process(size_t frames, double gain) noexcept;
+  std::span<const float> left() const { return {outLeft_.data(), frames_}; }  // the last process()
+  std::span<const float> right() const { return {outRight_.data(), frames_}; }
 
   bool sounding() const;  // a voice of the key is active
   bool fading() const { return fadeLeft_ > 0; }
   bool pending() const { return pendingVelocity_ >= 0.0; }
   bool busy() const { return sounding() || fading() || pending(); }  // needs process()
-  // Loudness, for stealing: the peak of the output followed sample by sample with a 50 ms
-  // release (so the choice does not depend on the block size); infinite for 50 ms after a strike,
-  // so a key just struck — its hammer still on the way — is not taken for a quiet one.
-  double loudness() const { return sinceStrike_ < attackSamples_ ? INFINITY : envelope_; }
+  // How far into its decay the key is, for stealing: the peak of its output followed sample by
+  // sample with a 50 ms release (so the choice does not depend on the block size), over the
+  // largest it has been since the last strike — 1 at its peak, 1e-3 at −60 dB. 1 for 50 ms after
+  // a strike, so a key just struck — its hammer still on the way — is not taken for a decayed one.
+  double level() const;
   long order() const { return order_; }  // when it was struck: higher is newer
   int guardEvents() const;
   double fundamentalHz() const;
@@ -52,14 +59,15 @@ class KeyVoice {
 
   std::vector<StringVoice> strings_;  // the unisons (string model)
   std::unique_ptr<PlateVoice> plate_;
-  std::vector<float> voiceLeft_, voiceRight_, mixLeft_, mixRight_;
+  std::vector<float> voiceLeft_, voiceRight_, mixLeft_, mixRight_, outLeft_, outRight_;
+  size_t frames_ = 0;  // written to the outputs by the last process()
   double panLeft_ = 1.0, panRight_ = 1.0;
   int fadeSamples_ = 1, fadeLeft_ = 0;
   double pendingVelocity_ = -1.0;  // < 0: none
   bool releasePending_ = false;    // released before its pending strike
   double damperScale_ = 1.0;       // the pending release's
   long order_ = 0;
-  double envelope_ = 0.0, envelopeDecay_ = 0.0;
+  double envelope_ = 0.0, loudest_ = 0.0, envelopeDecay_ = 0.0;  // loudest_: since the strike
   long sinceStrike_ = 0, attackSamples_ = 0;
 };
 

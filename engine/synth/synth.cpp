@@ -6,6 +6,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
 #include "synth/denormals.h"
 
@@ -16,9 +17,14 @@ void Synth::prepare(std::vector<Instrument> instruments, const SynthSetup& setup
   if (setup.maxBlock < 1 || setup.maxBlock > 65536)
     throw std::invalid_argument("block size " + std::to_string(setup.maxBlock) +
                                 ": must be between 1 and 65536 frames");
+  if (setup.threads < 0 || setup.threads > kMaxThreads)
+    throw std::invalid_argument("threads = " + std::to_string(setup.threads) +
+                                ": must be between 0 (one per core) and " +
+                                std::to_string(kMaxThreads));
   std::vector<std::vector<KeyVoice>> voices(instruments.size());
   std::vector<std::vector<bool>> hasVoice(instruments.size());
   std::vector<double> gains;
+  size_t keys = 0;
   for (size_t p = 0; p < instruments.size(); ++p) {
     const Instrument& instrument = instruments[p];
     if (instrument.polyphony < 1 || instrument.lowestNote > instrument.highestNote)
@@ -35,29 +41,36 @@ void Synth::prepare(std::vector<Instrument> instruments, const SynthSetup& setup
           (note >= static_cast<int>(setup.notes.size()) || !setup.notes[note]))
         continue;
       try {
-        voices[p][i].prepare(instrument, note, setup.sampleRate, setup.maxBlock);
+        voices[p][i].prepare(instrument, note, setup.sampleRate, setup.maxBlock,
+                             setup.freeQuietVoices);
       } catch (const std::exception& e) {
         throw std::invalid_argument(instrument.source + ": note " + std::to_string(note) + ": " +
                                     e.what());
       }
       hasVoice[p][i] = true;
+      ++keys;
     }
     gains.push_back(std::pow(10.0, instrument.gainDb / 20.0));
   }
   MasterBus master;
   master.prepare(setup.sampleRate);
+  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  auto pool = std::make_unique<WorkerPool>(setup.threads > 0 ? setup.threads : cores);
 
   instruments_ = std::move(instruments);
   voices_ = std::move(voices);
   hasVoice_ = std::move(hasVoice);
   gains_ = std::move(gains);
+  busy_.assign(keys, {});
+  pool_ = std::move(pool);
   master_ = master;
   maxBlock_ = setup.maxBlock;
   program_ = 0;
   std::fill(std::begin(downProgram_), std::end(downProgram_), -1);
   sustain_ = false;
   bend_ = 0.0;
-  strikes_ = 0;
+  strikes_ = steals_ = 0;
+  loudestSteal_ = 0.0;
 }
 
 KeyVoice* Synth::keyVoice(int program, int note) {
@@ -100,22 +113,26 @@ int Synth::guardEvents() const {
   return events;
 }
 
-// Released keys first (neither held nor sustained), the oldest of them, as they have decayed
-// longest; else the quietest held key (KeyVoice::loudness), the oldest on a tie. It fades out over
-// 5 ms. False when no key can be taken (all are fading already).
+// The key furthest below its own peak (KeyVoice::level): the furthest into its decay, whether
+// a damper or its own loss is taking it there, so the least of what it still had to sound is
+// cut; on a tie (keys just struck count as at their peak) a released key (neither held nor
+// sustained) first, then the oldest. It fades out over 5 ms. False when no key can be taken (all
+// are fading already).
 bool Synth::stealOne() noexcept {
   KeyVoice* victim = nullptr;
   auto better = [&](const KeyVoice& v) {
     if (!victim) return true;
+    if (v.level() != victim->level()) return v.level() < victim->level();
     const bool free = !v.down && !v.sustained, victimFree = !victim->down && !victim->sustained;
     if (free != victimFree) return free;
-    if (!free && v.loudness() != victim->loudness()) return v.loudness() < victim->loudness();
     return v.order() < victim->order();
   };
   for (auto& keys : voices_)
     for (KeyVoice& v : keys)
       if (v.sounding() && !v.fading() && !v.pending() && better(v)) victim = &v;
   if (!victim) return false;
+  ++steals_;
+  loudestSteal_ = std::max(loudestSteal_, victim->level());
   victim->fadeOut();
   return true;
 }
@@ -220,9 +237,24 @@ void Synth::handle(const MidiMessage& m) noexcept {
 }
 
 void Synth::render(std::span<float> left, std::span<float> right) noexcept {
+  int count = 0;
   for (size_t p = 0; p < voices_.size(); ++p)
     for (KeyVoice& v : voices_[p])
-      if (v.busy()) v.process(left, right, gains_[p]);
+      if (v.busy()) busy_[count++] = {&v, gains_[p]};
+  auto renderKey = [this, frames = left.size()](int k) noexcept {
+    busy_[k].voice->process(frames, busy_[k].gain);
+  };
+  pool_->run(count, renderKey);
+  // The keys' outputs summed in (instrument, note) order: the same float additions, in the same
+  // order, whichever thread rendered which key.
+  for (int k = 0; k < count; ++k) {
+    const std::span<const float> keyLeft = busy_[k].voice->left(),
+                                 keyRight = busy_[k].voice->right();
+    for (size_t i = 0; i < left.size(); ++i) {
+      left[i] += keyLeft[i];
+      right[i] += keyRight[i];
+    }
+  }
 }
 
 void Synth::process(std::span<float> left, std::span<float> right,

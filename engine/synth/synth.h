@@ -1,8 +1,10 @@
 // The synthesizer: the loaded instruments, a voice for every key of each (built in prepare(),
 // never on the audio path), MIDI semantics, voice allocation under a polyphony limit, and the
-// master section. process() is real-time safe: no allocation, lock or I/O.
+// master section. process() is real-time safe: no allocation, lock or I/O; the keys it shares with
+// the worker threads (SynthSetup::threads) are handed over without a lock (synth/worker_pool.h).
 #pragma once
 
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -10,6 +12,7 @@
 #include "synth/instrument.h"
 #include "synth/key_voice.h"
 #include "synth/master_bus.h"
+#include "synth/worker_pool.h"
 
 namespace hamiltone {
 
@@ -25,6 +28,13 @@ struct SynthSetup {
   // Which MIDI notes get voices; empty: every note of each instrument's range. An offline render
   // that knows its notes saves the preparation of the others (plates are slow to prepare).
   std::vector<bool> notes;
+  // Threads that render the keys, the caller's included: 0, one per core; 1, the caller alone.
+  // The output is bit-identical whatever the count (each key renders into its own buffer; the
+  // buffers are summed in a fixed order).
+  int threads = 0;
+  // Voices free themselves once silent, held or not (QuietDetector); false keeps them until they
+  // are stolen or silenced, for tests to compare against.
+  bool freeQuietVoices = true;
 };
 
 // MIDI, omni (every channel plays the current instrument):
@@ -38,7 +48,10 @@ struct SynthSetup {
 //   beyond the last), sounding notes ring on in the old one.
 class Synth {
  public:
-  // May allocate; throws std::invalid_argument naming the instrument, note and patch field.
+  static constexpr int kMaxThreads = 256;
+
+  // May allocate and start the worker threads; throws std::invalid_argument naming the
+  // instrument, note and patch field (or the thread count).
   void prepare(std::vector<Instrument> instruments, const SynthSetup& setup);
 
   // Writes left.size() frames (right must be as long). `events` sorted by offset, each offset in
@@ -48,7 +61,7 @@ class Synth {
   void handle(const MidiMessage& message) noexcept;  // now, between two samples
 
   // The limit on sounding keys; 0 restores the instrument's own polyphony. Keys beyond a lowered
-  // limit fade out at once (released keys first, the oldest of them; then the quietest).
+  // limit fade out at once, those furthest below their own peak first (as stealOne()).
   void setPolyphony(int voices) noexcept;
   // How long the dampers take, as a multiple of each key's damper_t60_s (1: the preset's), clamped
   // to 0.1 … 10: a performance control, like the pedal, for the keys released from now on.
@@ -58,6 +71,15 @@ class Synth {
   int program() const { return program_; }
   int guardEvents() const;
   long nonFiniteSamples() const { return master_.nonFinite(); }
+  int threads() const { return pool_ ? pool_->threads() : 1; }
+  // The worker threads take this scheduling policy and priority (see WorkerPool::schedule).
+  bool scheduleWorkers(int policy, int priority) noexcept {
+    return pool_ && pool_->schedule(policy, priority);
+  }
+  // Keys stolen since prepare(), and the highest level under its own peak any of them had when
+  // taken (KeyVoice::level: 1e-3 is −60 dB) — how much sound the polyphony limit has cut.
+  long steals() const { return steals_; }
+  double loudestSteal() const { return loudestSteal_; }
   const std::vector<Instrument>& instruments() const { return instruments_; }
   // The key's voice, or nullptr when that note has none.
   const KeyVoice* voice(int program, int note) const;
@@ -72,10 +94,18 @@ class Synth {
   KeyVoice* keyVoice(int program, int note);
   bool stealOne() noexcept;
 
+  struct BusyKey {
+    KeyVoice* voice;
+    double gain;  // its instrument's
+  };
+
   std::vector<Instrument> instruments_;
   std::vector<std::vector<KeyVoice>> voices_;  // [instrument][note − lowest]
   std::vector<std::vector<bool>> hasVoice_;
   std::vector<double> gains_;  // per instrument, linear
+  // The keys a piece renders, in (instrument, note) order; room for every key.
+  std::vector<BusyKey> busy_;
+  std::unique_ptr<WorkerPool> pool_;  // renders busy_ (a pointer: the pool's threads stay put)
   MasterBus master_;
   int maxBlock_ = 0;
   int program_ = 0, polyphonyOverride_ = 0;
@@ -84,6 +114,8 @@ class Synth {
   double bend_ = 0.0;  // −1 … 1 of the range
   double damperScale_ = 1.0;
   long strikes_ = 0;
+  long steals_ = 0;
+  double loudestSteal_ = 0.0;
 };
 
 }  // namespace hamiltone

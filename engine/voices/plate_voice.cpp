@@ -145,7 +145,7 @@ void PlateVoice::reset() noexcept {
   *scheme_ = *atRest_;
   for (Decimator& d : decimators_) d.reset();
   for (DcBlocker& b : dcBlockers_) b.reset();
-  pulsing_ = active_ = released_ = false;
+  pulsing_ = active_ = false;
   quiet_.reset();
 }
 
@@ -160,7 +160,7 @@ void PlateVoice::noteOn(double velocity) noexcept {
   pulseForce_ = patch_.forceMax * std::pow(v, patch_.velocityCurve);
   pulseTime_ = 0.0;
   pulsing_ = true;
-  released_ = false;
+  quiet_.strike();
   active_ = true;
   scheme_->setSigma0(loss_.sigma0);
 }
@@ -177,7 +177,6 @@ double PlateVoice::pulseOverStep() const noexcept {
 }
 
 void PlateVoice::release(double damperScale) noexcept {
-  released_ = true;
   scheme_->setSigma0(releasedSigma0(loss_.sigma0, patch_.damperT60, damperScale, k_));
 }
 
@@ -243,7 +242,7 @@ void PlateVoice::process(std::span<float> left, std::span<float> right) noexcept
     reset();
     return;
   }
-  if (quiet_.update(released_, left, right, rightCount)) active_ = false;
+  if (quiet_.update(left, right, rightCount)) active_ = false;
 }
 
 }  // namespace hamiltone

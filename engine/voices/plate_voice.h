@@ -53,6 +53,8 @@ class PlateVoice {
   void noteOn(double velocity) noexcept;  // 0 … 1: a harder strike is louder and shorter
   // The damper falls, its T60 damper_t60_s times `damperScale` (releasedSigma0).
   void release(double damperScale = 1.0) noexcept;
+  // Where the voice counts as silent and frees itself, as StringVoice::setQuietFloor.
+  void setQuietFloor(double floor) noexcept { quiet_.setFloor(floor); }
 
   // Writes the next left.size() samples (and min(left, right) of right). Never allocates.
   void process(std::span<float> left, std::span<float> right) noexcept;
@@ -80,7 +82,7 @@ class PlateVoice {
 
   double pulseTime_ = 0.0, pulseDuration_ = 0.0, pulseForce_ = 0.0;
   int guardEvents_ = 0;
-  bool active_ = false, released_ = false, pulsing_ = false;
+  bool active_ = false, pulsing_ = false;
 };
 
 }  // namespace hamiltone

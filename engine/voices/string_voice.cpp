@@ -191,7 +191,7 @@ void StringVoice::reset() noexcept {
   injected_ = caught_ = 0.0;
   separatedSteps_ = 0;
   quiet_.reset();
-  active_ = released_ = struck_ = false;
+  active_ = struck_ = false;
   parked_ = true;
   applyBend();  // the copy brought back β = 1
 }
@@ -242,12 +242,11 @@ void StringVoice::noteOn(double velocity) noexcept {
   scheme_->setSigma0(loss_.sigma0);
   separatedSteps_ = 0;
   struck_ = parked_ = false;
-  released_ = false;
+  quiet_.strike();
   active_ = true;
 }
 
 void StringVoice::release(double damperScale) noexcept {
-  released_ = true;
   scheme_->setSigma0(releasedSigma0(loss_.sigma0, patch_.damperT60, damperScale, k_));
 }
 
@@ -332,7 +331,7 @@ void StringVoice::process(std::span<float> left, std::span<float> right) noexcep
     reset();
     return;
   }
-  if (quiet_.update(released_, left, right, rightCount)) active_ = false;
+  if (quiet_.update(left, right, rightCount)) active_ = false;
 }
 
 }  // namespace hamiltone

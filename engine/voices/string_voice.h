@@ -70,6 +70,9 @@ class StringVoice {
   // Bends the pitch by `semitones` (clamped to ±bendRange) by retensioning the transverse wave:
   // β T0 is solved in closed form so the scheme's fundamental moves by exactly that interval.
   void setBend(double semitones) noexcept;
+  // Where the voice counts as silent and frees itself (QuietDetector::setFloor): in its output
+  // units, negative for never. The default, QuietDetector::kFloor, is −100 dB under unit output.
+  void setQuietFloor(double floor) noexcept { quiet_.setFloor(floor); }
 
   // Writes (not adds) the next left.size() samples; a stereo patch also writes the first
   // min(left, right) samples of right, a mono one leaves right alone. Never allocates.
@@ -104,7 +107,7 @@ class StringVoice {
   double injected_ = 0.0, caught_ = 0.0;
   int guardEvents_ = 0;
   int separatedSteps_ = 0;
-  bool active_ = false, released_ = false, struck_ = false;
+  bool active_ = false, struck_ = false;
   bool parked_ = true;  // the back-check holds the hammer (until the next strike)
 };
 

@@ -54,6 +54,15 @@ TEST_F(PlayCli, RefusesABadSetBeforeOpeningAnyDevice) {
   }
 }
 
+TEST_F(PlayCli, RefusesABadThreadCountBeforeOpeningAnyDevice) {
+  for (const char* threads : {"0", "257", "all"}) {
+    const CommandResult r = play("--quiet --threads " + std::string(threads));
+    EXPECT_EQ(r.exitCode, 2) << threads << "\n" << r.err;
+    EXPECT_NE(r.err.find("--threads = "), std::string::npos) << threads << "\n" << r.err;
+    EXPECT_NE(r.err.find("from 1 to 256"), std::string::npos) << threads << "\n" << r.err;
+  }
+}
+
 // Past the presets: the refusal is the audio API's, not a preset's.
 TEST_F(PlayCli, AcceptsAGoodSetAndGoesOnToTheAudioDevice) {
   const CommandResult r = play("--preset " + preset("paper-c3-string") +

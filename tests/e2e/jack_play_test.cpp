@@ -184,16 +184,17 @@ class JackPlay : public ::testing::Test {
         << slurp(dir_ / "player.err");
   }
 
-  // A server of its own, the player on it, the score from the sender, at least 10 s of audio;
-  // then SIGINT to the player and SIGTERM to the server. Fatal failures for anything that keeps
-  // the run from happening.
+  // A server of its own, the player on it (its keys rendered on 2 threads: the audio callback
+  // and one worker, whatever the host's cores), the score from the sender, at least 10 s of
+  // audio; then SIGINT to the player and SIGTERM to the server. Fatal failures for anything that
+  // keeps the run from happening.
   void perform(bool realtime, int attempt, Performance& run) {
     stopAll();
     useServer(name_ + "-" + std::to_string(attempt));
     ASSERT_NO_FATAL_FAILURE(startServer(realtime));
     ASSERT_NO_FATAL_FAILURE(
         startPlayer({"--preset", HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml", "--preset",
-                     HAMILTONE_SOURCE_DIR "/presets/paper-c3-string.toml"}));
+                     HAMILTONE_SOURCE_DIR "/presets/paper-c3-string.toml", "--threads", "2"}));
     const Clock::time_point readyAt = Clock::now();
 
     spawn(sender_, {HAMILTONE_MIDI_SENDER, "hamiltone-in", "10"}, "sender");

@@ -7,8 +7,10 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -415,6 +417,42 @@ TEST(MidiFile, BundledDemoParses) {
   EXPECT_GT(notes, 20);
   EXPECT_GT(releasesByVelocity0, 0);
   EXPECT_GE(pedals, 2);
+}
+
+// presets/dense-pedalled.mid, written by scripts/make-dense-midi.py for the stealing test and the
+// polyphony benchmark: at least 400 notes in 40 s over the keyboard, the pedal changed with the
+// harmony, and at times 20 keys or more held at once, down or kept by the pedal.
+TEST(MidiFile, BundledDensePerformanceIsDense) {
+  const MidiFile dense =
+      readMidiFile(std::filesystem::path(HAMILTONE_SOURCE_DIR) / "presets/dense-pedalled.mid");
+  bool down[128] = {}, kept[128] = {}, pedal = false;
+  int notes = 0, pedals = 0, most = 0, lowest = 127, highest = 0;
+  for (const TimedMessage& m : dense.messages) {
+    const MidiMessage& msg = m.message;
+    const int key = msg.data1 & 0x7F;
+    if (msg.kind() == midi::noteOn && msg.data2 > 0) {
+      notes += m.seconds < 40.0;
+      down[key] = true;
+      kept[key] = false;
+      lowest = std::min(lowest, key);
+      highest = std::max(highest, key);
+    } else if (msg.kind() == midi::noteOn || msg.kind() == midi::noteOff) {
+      down[key] = false;
+      kept[key] = pedal;
+    } else if (msg.kind() == midi::controller && msg.data1 == midi::sustainPedal) {
+      ++pedals;
+      pedal = msg.data2 >= 64;
+      if (!pedal) std::fill(std::begin(kept), std::end(kept), false);
+    }
+    int held = 0;
+    for (int k = 0; k < 128; ++k) held += down[k] || kept[k];
+    most = std::max(most, held);
+  }
+  EXPECT_GE(notes, 400);
+  EXPECT_GE(pedals, 20);
+  EXPECT_GE(most, 20);
+  EXPECT_LE(lowest, 36);   // across the keyboard: C2 and below …
+  EXPECT_GE(highest, 84);  // … to C6 and above
 }
 
 }  // namespace

@@ -1,5 +1,5 @@
-// ProgressBar and renderSummary: the summary's wording and arithmetic, a disabled bar that stays
-// silent, and an enabled one that draws one '\r' line, throttled, and clears it.
+// ProgressBar, renderSummary and stealSummary: the summaries' wording and arithmetic, a disabled
+// bar that stays silent, and an enabled one that draws one '\r' line, throttled, and clears it.
 #include "progress_bar.h"
 
 #include <gtest/gtest.h>
@@ -13,6 +13,7 @@ namespace {
 
 using hamiltone::cli::ProgressBar;
 using hamiltone::cli::renderSummary;
+using hamiltone::cli::stealSummary;
 
 // A temporary stream standing in for stderr; text() is everything written so far.
 class CapturedStream {
@@ -44,6 +45,14 @@ TEST(RenderSummary, RealTimeFactorIsWallOverAudioTime) {
 TEST(RenderSummary, NoFactorWithoutAWallTimeOrAudio) {
   EXPECT_EQ(renderSummary(12.5, 0.0), "rendered 12.50 s of audio in 0.00 s");
   EXPECT_EQ(renderSummary(0.0, 1.0), "rendered 0.00 s of audio in 1.00 s");
+}
+
+TEST(RenderSummary, StealsWithTheLoudestInDecibels) {
+  EXPECT_EQ(stealSummary(0, 0.0, 64), "no key stolen at the limit of 64 voices");
+  EXPECT_EQ(stealSummary(1, 1e-3, 64),
+            "1 key stolen at the limit of 64 voices, the loudest at -60.0 dB of its own peak");
+  EXPECT_EQ(stealSummary(12, 0.5, 16),
+            "12 keys stolen at the limit of 16 voices, the loudest at -6.0 dB of its own peak");
 }
 
 TEST(ProgressBar, DisabledWritesNothing) {

@@ -1,64 +1,34 @@
 // The synthesizer: MIDI semantics (sustain, re-strike, all notes off, bend, program, volume),
 // voice allocation under the polyphony limit and its stealing order, a click-free steal, the
-// master section's bounds, determinism and independence of the block size.
+// master section's bounds, determinism, and independence of the block size and the thread count.
 #include "synth/synth.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 #include "support/modal.h"
+#include "support/synth_takes.h"
 #include "support/test_instruments.h"
 #include "synth/denormals.h"
 
 namespace hamiltone {
 namespace {
 
+using testing::cc;
+using testing::off;
+using testing::on;
+using testing::peak;
 using testing::pianoKeys;
+using testing::prepared;
+using testing::render;
+using testing::smallPlate;
+using testing::Take;
 
-constexpr double kRate = 48000.0;
-
-MidiMessage on(int note, int velocity = 100) { return {0x90, uint8_t(note), uint8_t(velocity)}; }
-MidiMessage off(int note) { return {0x80, uint8_t(note), 0}; }
-MidiMessage cc(int controller, int value) { return {0xB0, uint8_t(controller), uint8_t(value)}; }
-
-struct Take {
-  std::vector<float> left, right;
-};
-
-// Renders `seconds` with the messages at their times (seconds), in blocks of `block` frames.
-Take render(Synth& synth, std::vector<TimedMessage> messages, double seconds, int block) {
-  const long frames = std::lround(seconds * kRate);
-  Take take{std::vector<float>(frames), std::vector<float>(frames)};
-  std::vector<SynthEvent> events;
-  size_t next = 0;
-  for (long start = 0; start < frames; start += block) {
-    const long n = std::min<long>(block, frames - start);
-    events.clear();
-    while (next < messages.size() && std::lround(messages[next].seconds * kRate) < start + n) {
-      events.push_back(
-          {int(std::lround(messages[next].seconds * kRate) - start), messages[next].message});
-      ++next;
-    }
-    synth.process(std::span(take.left).subspan(start, n), std::span(take.right).subspan(start, n),
-                  events);
-  }
-  return take;
-}
-
-Synth prepared(std::vector<Instrument> instruments, int maxBlock = 256) {
-  Synth synth;
-  synth.prepare(std::move(instruments), {.sampleRate = kRate, .maxBlock = maxBlock, .notes = {}});
-  return synth;
-}
-
-float peak(const std::vector<float>& x, size_t from = 0, size_t to = SIZE_MAX) {
-  float p = 0.0f;
-  for (size_t i = from; i < std::min(to, x.size()); ++i) p = std::max(p, std::abs(x[i]));
-  return p;
-}
+constexpr double kRate = testing::kTakeRate;
 
 TEST(Synth, SustainHoldsReleasedNotesUntilThePedalLifts) {
   Synth synth = prepared({pianoKeys(48, 50)});
@@ -112,21 +82,31 @@ TEST(Synth, AllNotesOffReleasesHeldKeysAndAllSoundOffSilences) {
   EXPECT_LT(peak(take.left, 12000), 1e-3f * peak(before.left));
 }
 
-TEST(Synth, PolyphonyLimitStealsReleasedKeysFirstThenTheQuietest) {
-  Synth synth = prepared({pianoKeys(48, 60, 3)});
-  // 48 soft and held, 50 loud and held, 52 loud and released: at the limit of 3, a fourth key
-  // steals 52 (released) although 48 is quieter.
-  render(synth, {{0.0, on(48, 20)}, {0.0, on(50, 127)}, {0.0, on(52, 127)}, {0.05, off(52)}}, 0.1,
+// At the limit the key furthest below its own peak goes, held or not: 48, held, decays fast
+// (T60 1 s) and after a second is further below its peak (about −60 dB) than 50, released 0.15 s
+// ago (damper 0.25 s: about −26 dB); then 50 goes before 52, held and struck 0.1 s ago. Each
+// steal is counted with the stolen key's level.
+TEST(Synth, PolyphonyLimitStealsTheKeyFurthestBelowItsPeak) {
+  Instrument piano = pianoKeys(48, 60, 3);
+  piano.keys[0].patch.t60Low = piano.keys[0].patch.t60High = 1.0;
+  Synth synth = prepared({piano});
+  render(synth, {{0.0, on(48, 127)}, {0.8, on(50, 127)}, {0.85, off(50)}, {0.9, on(52, 127)}}, 1.0,
          64);
   ASSERT_EQ(synth.activeVoices(), 3);
+  const double held = synth.voice(0, 48)->level(), released = synth.voice(0, 50)->level();
+  ASSERT_LT(held, released);
+  ASSERT_LT(released, synth.voice(0, 52)->level());
   render(synth, {{0.0, on(55)}}, 0.02, 64);
-  EXPECT_FALSE(synth.voice(0, 52)->sounding());
-  EXPECT_TRUE(synth.voice(0, 48)->sounding());
-  EXPECT_EQ(synth.activeVoices(), 3);
-  // All held now: the quietest (48, struck softly) goes.
-  render(synth, {{0.0, on(57)}}, 0.02, 64);
   EXPECT_FALSE(synth.voice(0, 48)->sounding());
   EXPECT_TRUE(synth.voice(0, 50)->sounding());
+  EXPECT_EQ(synth.activeVoices(), 3);
+  render(synth, {{0.0, on(57)}}, 0.02, 64);
+  EXPECT_FALSE(synth.voice(0, 50)->sounding());
+  EXPECT_TRUE(synth.voice(0, 52)->sounding());
+  EXPECT_EQ(synth.steals(), 2);
+  // The louder of the two: 50, 20 ms further into its damping than when measured.
+  EXPECT_LT(synth.loudestSteal(), released);
+  EXPECT_GT(synth.loudestSteal(), held);
   // The CLI's --voices overrides the preset's polyphony.
   synth.setPolyphony(1);
   render(synth, {{0.0, on(59)}}, 0.02, 64);
@@ -157,6 +137,35 @@ TEST(Synth, OutputIsBitIdenticalForTheSameInput) {
   const Take x = render(a, score, 0.4, 64), y = render(b, score, 0.4, 64);
   EXPECT_EQ(x.left, y.left);
   EXPECT_EQ(x.right, y.right);
+}
+
+bool sameBits(const std::vector<float>& a, const std::vector<float>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
+}
+
+// Each key renders into its own buffer and the buffers are summed in (instrument, note) order,
+// so which thread rendered which key cannot show in the output: 2, 3 and 4 threads (more than
+// this machine's cores) give the bits of 1. The score has everything that changes a key's state
+// between two blocks or inside one: a chord, restrikes, the pedal, steals (polyphony 4 of 7
+// keys), a bend, a program change to a plate and back, all sound off and a strike in its fade.
+TEST(Synth, OutputIsBitIdenticalWhateverTheThreadCount) {
+  const std::vector<TimedMessage> score = {
+      {0.0, on(48)},       {0.0, on(52, 60)},     {0.0, on(55, 90)},    {0.01, cc(64, 127)},
+      {0.02, on(58, 110)}, {0.03, off(48)},       {0.04, on(60, 40)},   {0.05, on(48, 127)},
+      {0.06, on(53, 70)},  {0.07, {0xE0, 0, 90}}, {0.08, {0xC0, 1, 0}}, {0.08, on(60, 127)},
+      {0.09, on(61, 100)}, {0.1, {0xC0, 0, 0}},   {0.1, on(52, 100)},   {0.11, cc(64, 0)},
+      {0.12, cc(120, 0)},  {0.122, on(55, 80)},   {0.13, off(55)},      {0.14, on(57, 127)}};
+  std::vector<Take> takes;
+  for (int threads : {1, 2, 3, 4}) {
+    Synth synth = prepared({pianoKeys(48, 60, 4), smallPlate()}, 100, true, threads);
+    EXPECT_EQ(synth.threads(), threads);
+    takes.push_back(render(synth, score, 0.3, 100));
+  }
+  ASSERT_GT(peak(takes[0].left), 1e-3f);
+  for (size_t t = 1; t < takes.size(); ++t) {
+    EXPECT_TRUE(sameBits(takes[t].left, takes[0].left)) << t + 1 << " threads";
+    EXPECT_TRUE(sameBits(takes[t].right, takes[0].right)) << t + 1 << " threads";
+  }
 }
 
 // Blocks of 1, 64 and 1000 frames: events land on the same samples, every voice runs sample by
@@ -297,6 +306,11 @@ TEST(Synth, RejectsBadSetups) {
   EXPECT_THROW(
       synth.prepare({pianoKeys(60, 60)}, {.sampleRate = kRate, .maxBlock = 0, .notes = {}}),
       std::invalid_argument);
+  for (int threads : {-1, Synth::kMaxThreads + 1})
+    EXPECT_THROW(
+        synth.prepare({pianoKeys(60, 60)},
+                      {.sampleRate = kRate, .maxBlock = 64, .notes = {}, .threads = threads}),
+        std::invalid_argument);
   Instrument broken = pianoKeys(60, 60);
   broken.keys[0].patch.oversampling = 3;
   try {

@@ -172,6 +172,19 @@ TEST(PlateVoice, ReleaseDampsAndFreesTheVoice) {
   EXPECT_FALSE(voice.active());
 }
 
+// Never released, a plate whose sound has died away frees itself too: T60 0.3 s takes a strike
+// under −80 dB of its peak within 0.5 s, so after 2 s only a voice kept for nothing would be left.
+TEST(PlateVoice, AHeldPlateFreesItselfOnceSilent) {
+  PlatePatch patch;
+  patch.t60Low = 0.3;
+  patch.t60High = 0.2;
+  PlateVoice voice;
+  voice.prepare(patch, 60, 48000.0);
+  voice.noteOn(0.8);
+  play(voice, 2.0, 48000.0, [] {});
+  EXPECT_FALSE(voice.active());
+}
+
 // A strike of 1e200 N overflows the state: the guard silences the block, resets and counts it.
 TEST(PlateVoice, GuardSilencesANonFiniteState) {
   PlatePatch patch;

@@ -1,0 +1,58 @@
+// The hot loops of the string voices, compiled for several instruction sets and chosen once, at
+// prepare(), from what the CPU reports: plain x86-64 (SSE2), x86-64-v3 (AVX2 + FMA) and x86-64-v4
+// (AVX-512). The same path on the same CPU gives the same bits run to run; two paths differ in
+// the order of their sums (the vector width), by roundoff.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+namespace hamiltone {
+
+enum class Isa { portable, avx2, avx512 };
+
+struct Kernels {
+  Isa isa;
+  const char* name;
+  // The two grids' strains (SCHEMES §3b): with up the padded u (m + 1 = mv r + 1 values) and
+  // η_J the coarse strains, each fine segment's s_l = sqrt((1 + η_J)² + ζ_l²), ζ_l = (up[l+1] −
+  // up[l]) invH; sets zetaOverS_l = ζ_l/s_l, strain_J = (1/r) Σ_{l∈J} (s_l − 1) (as (b + ζ²)/(s +
+  // 1), b = 2η + η²: no cancellation at small strain) and sumInverse_J = Σ_{l∈J} 1/s_l.
+  // scratch: 4 m doubles.
+  void (*cellStretches)(const double* up, const double* eta, long mv, int r, double invH,
+                        double* scratch, double* zetaOverS, double* strain, double* sumInverse);
+  // ∇_u V' = D₋ᵀ(c strain_J ζ_l/s_l): gu_l = (w_l − w_{l+1}) invH, l < m − 1. scratch: m doubles.
+  void (*fineForces)(long mv, int r, double c, double invH, const double* strain, double* scratch,
+                     const double* zetaOverS, double* gu);
+  // One grid (BDZ (65)): with up, vp the padded u and v (m + 1 values), ζ_l, η_l their strains
+  // and φ_l = (s_l − 1)/s_l, ∂V'/∂ζ_l = c φ_l ζ_l into wz and ∂V'/∂η_l = c φ_l (1 + η_l) into we
+  // (m each), gu = D₋ᵀwz and gv = D₋ᵀwe (m − 1 each); returns Σ (s_l − 1)².
+  double (*singleGridForces)(const double* up, const double* vp, long m, double invH, double c,
+                             double* wz, double* we, double* gu, double* gv);
+  // out_j = c (a_{j−1} − 2a_j + a_{j+1}), j < n, a = 0 beyond both ends.
+  void (*secondDifference)(const double* a, double* out, long n, double c);
+  // The same of a − b, the difference taken as it is read.
+  void (*secondDifferenceOfDifference)(const double* a, const double* b, double* out, long n,
+                                       double c);
+  // The split scheme's first pass with one part loaded (sav.h), x read as xScale·x: out = (gᵀq,
+  // gᵀqm, gᵀM⁻¹Kq, gᵀM⁻¹x, gᵀM⁻¹g); kq or x null: that sum is 0.
+  void (*savDots)(long n, const double* g, const double* q, const double* qm, const double* minv,
+                  const double* kq, const double* x, double xScale, double out[5]);
+  // Its second pass: qp_i = (2q_i − down qm_i − kk M⁻¹kq_i − M⁻¹x_i + c M⁻¹g_i) invUp (the kq and
+  // x terms absent when null, x read as xScale·x); returns gᵀ(qp − qm).
+  double (*savUpdate)(long n, const double* g, const double* q, const double* qm,
+                      const double* minv, const double* kq, const double* x, double xScale,
+                      double down, double kk, double c, double invUp, double* qp);
+};
+
+// The best path this CPU runs, or the one HAMILTONE_ISA names (portable, avx2, avx512): decided
+// once per process. Throws std::runtime_error when HAMILTONE_ISA names an unknown path or one
+// this CPU cannot run.
+const Kernels& selectedKernels();
+// A given path (tests and benchmarks compare them); throws std::runtime_error as above.
+const Kernels& kernelsFor(Isa isa);
+const Kernels& kernelsNamed(std::string_view name);  // by its name in isaNames()
+bool cpuRuns(Isa isa);
+std::string isaNames();  // "portable, avx2, avx512"
+
+}  // namespace hamiltone

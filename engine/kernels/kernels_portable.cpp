@@ -1,0 +1,8 @@
+// The kernels for the build's own target (plain x86-64: SSE2), which every CPU runs.
+#include "kernels/kernels.h"
+
+#define HAMILTONE_TARGET
+#define HAMILTONE_KERNEL_NS portable
+#define HAMILTONE_KERNEL_ISA Isa::portable
+#define HAMILTONE_KERNEL_NAME "portable"
+#include "kernels/kernel_loops.inl"
