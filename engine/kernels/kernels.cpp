@@ -20,6 +20,8 @@ extern const Kernels kernels;
 
 namespace {
 
+constexpr Isa kEveryIsa[] = {Isa::portable, Isa::avx2, Isa::avx512};
+
 const char* nameOf(Isa isa) {
   switch (isa) {
     case Isa::avx2:
@@ -59,7 +61,11 @@ bool cpuRuns(Isa isa) {
 #endif
 }
 
-std::string isaNames() { return "portable, avx2, avx512"; }
+std::string isaNames() {
+  std::string names;
+  for (Isa isa : kEveryIsa) names += std::string(names.empty() ? "" : ", ") + nameOf(isa);
+  return names;
+}
 
 const Kernels& kernelsFor(Isa isa) {
   if (!cpuRuns(isa))
@@ -73,7 +79,7 @@ const Kernels& kernelsFor(Isa isa) {
 }
 
 const Kernels& kernelsNamed(std::string_view name) {
-  for (Isa isa : {Isa::portable, Isa::avx2, Isa::avx512})
+  for (Isa isa : kEveryIsa)
     if (name == nameOf(isa)) return kernelsFor(isa);
   throw std::runtime_error("instruction set \"" + std::string(name) + "\": must be one of " +
                            isaNames());

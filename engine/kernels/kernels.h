@@ -1,7 +1,8 @@
-// The hot loops of the string voices, compiled for several instruction sets and chosen once, at
-// prepare(), from what the CPU reports: plain x86-64 (SSE2), x86-64-v3 (AVX2 + FMA) and x86-64-v4
-// (AVX-512). The same path on the same CPU gives the same bits run to run; two paths differ in
-// the order of their sums (the vector width), by roundoff.
+// The hot loops of the string voices, compiled for several instruction sets and chosen once per
+// process (when the first string or scheme is built) from what the CPU reports: plain x86-64
+// (SSE2), x86-64-v3 (AVX2 + FMA) and x86-64-v4 (AVX-512). The same path on the same CPU gives the
+// same bits run to run; two paths differ in the order of their sums (the vector width), by
+// roundoff.
 #pragma once
 
 #include <string>
