@@ -4,6 +4,7 @@
 
 #include <RtMidi.h>
 
+#include <algorithm>
 #include <chrono>
 
 #include "quiet_stderr.h"
@@ -16,12 +17,20 @@ std::int64_t steadyNanoseconds() {
       .count();
 }
 
+std::string portList(const std::vector<std::string>& names) {
+  std::string list;
+  for (size_t i = 0; i < names.size(); ++i)
+    list += (i ? "; " : "") + std::to_string(i) + ": " + names[i];
+  return list.empty() ? "none" : list;
+}
+
 struct MidiInput::Impl {
   std::unique_ptr<RtMidiIn> in;
-  bool open = false;  // a port and the callback are set
+  std::unique_ptr<RtMidiIn> watcher;  // lists the ports while `in` has one open
+  bool open = false;                  // a port and the callback are set
 };
 
-MidiInput::MidiInput(const std::string& api) : impl_(std::make_unique<Impl>()) {
+MidiInput::MidiInput(const std::string& api) : impl_(std::make_unique<Impl>()), api_(api) {
   const RtMidi::Api id = RtMidi::getCompiledApiByName(api == "pulse" ? "alsa" : api);
   if (id == RtMidi::UNSPECIFIED || id == RtMidi::RTMIDI_DUMMY)
     throw MidiError("MIDI API \"" + api + "\" is not available in this build");
@@ -49,18 +58,15 @@ std::vector<std::string> MidiInput::ports() {
 
 void MidiInput::openPort(int port) {
   const std::vector<std::string> names = ports();
-  if (port < 0 || port >= static_cast<int>(names.size())) {
-    std::string list;
-    for (size_t i = 0; i < names.size(); ++i)
-      list += (i ? "; " : "") + std::to_string(i) + ": " + names[i];
+  if (port < 0 || port >= static_cast<int>(names.size()))
     throw MidiError("--midi-port " + std::to_string(port) +
-                    ": no such MIDI input port; ports: " + (list.empty() ? "none" : list));
-  }
+                    ": no such MIDI input port; ports: " + portList(names));
   try {
     const QuietStderr quiet;
     impl_->in->setCallback(&MidiInput::arrived, this);
     impl_->in->openPort(static_cast<unsigned>(port), "hamiltone-in");
     impl_->open = true;
+    portName_ = names[static_cast<size_t>(port)];
   } catch (const RtMidiError& e) {
     throw MidiError("cannot open MIDI port " + std::to_string(port) + ": " + e.getMessage());
   }
@@ -75,6 +81,31 @@ void MidiInput::openVirtualPort(const std::string& name) {
   } catch (const RtMidiError& e) {
     throw MidiError("cannot create the virtual MIDI port \"" + name + "\": " + e.getMessage());
   }
+}
+
+bool MidiInput::portPresent() {
+  if (portName_.empty()) return true;
+  const QuietStderr quiet;
+  try {
+    if (!impl_->watcher)
+      impl_->watcher = std::make_unique<RtMidiIn>(
+          RtMidi::getCompiledApiByName(api_ == "pulse" ? "alsa" : api_), "hamiltone-watch");
+    const unsigned count = impl_->watcher->getPortCount();
+    for (unsigned i = 0; i < count; ++i)
+      if (impl_->watcher->getPortName(i) == portName_) return true;
+  } catch (const RtMidiError&) {
+    return true;  // cannot tell
+  }
+  return false;
+}
+
+void MidiInput::reconnect() {
+  const std::string name = portName_;
+  const std::vector<std::string> names = ports();
+  const auto found = std::find(names.begin(), names.end(), name);
+  if (found == names.end()) throw MidiError("MIDI input port \"" + name + "\" is not there");
+  close();
+  openPort(static_cast<int>(found - names.begin()));
 }
 
 void MidiInput::close() {
