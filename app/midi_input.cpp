@@ -24,6 +24,21 @@ std::string portList(const std::vector<std::string>& names) {
   return list.empty() ? "none" : list;
 }
 
+std::string stablePortName(const std::string& name) {
+  const size_t space = name.rfind(' ');
+  if (space == std::string::npos) return name;
+  const std::string tail = name.substr(space + 1);
+  const size_t colon = tail.find(':');
+  const auto digits = [](const std::string& t) {
+    return !t.empty() &&
+           std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; });
+  };
+  if (colon == std::string::npos || !digits(tail.substr(0, colon)) ||
+      !digits(tail.substr(colon + 1)))
+    return name;
+  return name.substr(0, space);
+}
+
 struct MidiInput::Impl {
   std::unique_ptr<RtMidiIn> in;
   std::unique_ptr<RtMidiIn> watcher;  // lists the ports while `in` has one open
@@ -92,7 +107,7 @@ bool MidiInput::portPresent() {
           RtMidi::getCompiledApiByName(api_ == "pulse" ? "alsa" : api_), "hamiltone-watch");
     const unsigned count = impl_->watcher->getPortCount();
     for (unsigned i = 0; i < count; ++i)
-      if (impl_->watcher->getPortName(i) == portName_) return true;
+      if (stablePortName(impl_->watcher->getPortName(i)) == stablePortName(portName_)) return true;
   } catch (const RtMidiError&) {
     return true;  // cannot tell
   }
@@ -102,7 +117,9 @@ bool MidiInput::portPresent() {
 void MidiInput::reconnect() {
   const std::string name = portName_;
   const std::vector<std::string> names = ports();
-  const auto found = std::find(names.begin(), names.end(), name);
+  const auto found = std::find_if(names.begin(), names.end(), [&](const std::string& n) {
+    return stablePortName(n) == stablePortName(name);
+  });
   if (found == names.end()) throw MidiError("MIDI input port \"" + name + "\" is not there");
   close();
   openPort(static_cast<int>(found - names.begin()));
