@@ -4,8 +4,10 @@
 
 #include <RtAudio.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cstdio>
+#include <cstdlib>
 
 #include "quiet_stderr.h"
 
@@ -100,11 +102,27 @@ std::vector<AudioDevice> AudioOutput::devices() {
       const RtAudio::DeviceInfo info = impl_->audio->getDeviceInfo(i);
       if (!info.probed || info.outputChannels < 1) continue;
       list.push_back({static_cast<int>(i), info.name, static_cast<int>(info.outputChannels),
-                      info.isDefaultOutput});
+                      info.isDefaultOutput, info.sampleRates, info.preferredSampleRate});
     }
   } catch (const RtAudioError&) {
   }
   return list;
+}
+
+AudioDevice AudioOutput::device(int id) {
+  for (AudioDevice& d : devices())
+    if (d.id == id) return d;
+  throw AudioError("device " + std::to_string(id) + " of API " + api_ + " is gone");
+}
+
+unsigned chooseSampleRate(unsigned requested, const AudioDevice& device) {
+  const std::vector<unsigned>& rates = device.sampleRates;
+  if (rates.empty() || std::find(rates.begin(), rates.end(), requested) != rates.end())
+    return requested;
+  if (device.preferredRate > 0) return device.preferredRate;
+  return *std::min_element(rates.begin(), rates.end(), [requested](unsigned a, unsigned b) {
+    return std::labs(long(a) - long(requested)) < std::labs(long(b) - long(requested));
+  });
 }
 
 int AudioOutput::resolve(int device) {
@@ -145,6 +163,8 @@ void AudioOutput::open(int device, unsigned sampleRate, unsigned& bufferFrames, 
                      "; devices: " + deviceList(devices()));
   }
 }
+
+unsigned AudioOutput::streamRate() const { return impl_->audio->getStreamSampleRate(); }
 
 void AudioOutput::start() {
   try {

@@ -20,7 +20,15 @@ struct AudioDevice {
   std::string name;
   int outputChannels = 0;
   bool isDefault = false;
+  // The rates it runs at (a JACK server: its one rate), and the one it prefers (0: none said).
+  std::vector<unsigned> sampleRates;
+  unsigned preferredRate = 0;
 };
+
+// The rate to open `device` at when `requested` is asked for: that one, if the device runs at it
+// or says nothing; otherwise the device's preferred rate (a JACK server's, PipeWire's JACK's), or
+// the one nearest to `requested` it lists.
+unsigned chooseSampleRate(unsigned requested, const AudioDevice& device);
 
 class AudioOutput {
  public:
@@ -34,11 +42,13 @@ class AudioOutput {
   ~AudioOutput();
 
   std::vector<AudioDevice> devices();
+  AudioDevice device(int id);  // one of devices(); AudioError if there is no such device
   // The device --device names (−1: the default), or AudioError naming the APIs or the devices.
   int resolve(int device);
   // Opens a stereo float stream at `sampleRate`; bufferFrames is a request the device may
   // change. Throws AudioError listing the devices.
   void open(int device, unsigned sampleRate, unsigned& bufferFrames, Render render);
+  unsigned streamRate() const;  // the open stream's rate
   void start();
   void stop();  // waits for the callback to finish; safe to call twice
   long underruns() const;

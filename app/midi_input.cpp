@@ -4,6 +4,7 @@
 
 #include <RtMidi.h>
 
+#include <algorithm>
 #include <chrono>
 
 #include "quiet_stderr.h"
@@ -16,12 +17,35 @@ std::int64_t steadyNanoseconds() {
       .count();
 }
 
+std::string portList(const std::vector<std::string>& names) {
+  std::string list;
+  for (size_t i = 0; i < names.size(); ++i)
+    list += (i ? "; " : "") + std::to_string(i) + ": " + names[i];
+  return list.empty() ? "none" : list;
+}
+
+std::string stablePortName(const std::string& name) {
+  const size_t space = name.rfind(' ');
+  if (space == std::string::npos) return name;
+  const std::string tail = name.substr(space + 1);
+  const size_t colon = tail.find(':');
+  const auto digits = [](const std::string& t) {
+    return !t.empty() &&
+           std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; });
+  };
+  if (colon == std::string::npos || !digits(tail.substr(0, colon)) ||
+      !digits(tail.substr(colon + 1)))
+    return name;
+  return name.substr(0, space);
+}
+
 struct MidiInput::Impl {
   std::unique_ptr<RtMidiIn> in;
-  bool open = false;  // a port and the callback are set
+  std::unique_ptr<RtMidiIn> watcher;  // lists the ports while `in` has one open
+  bool open = false;                  // a port and the callback are set
 };
 
-MidiInput::MidiInput(const std::string& api) : impl_(std::make_unique<Impl>()) {
+MidiInput::MidiInput(const std::string& api) : impl_(std::make_unique<Impl>()), api_(api) {
   const RtMidi::Api id = RtMidi::getCompiledApiByName(api == "pulse" ? "alsa" : api);
   if (id == RtMidi::UNSPECIFIED || id == RtMidi::RTMIDI_DUMMY)
     throw MidiError("MIDI API \"" + api + "\" is not available in this build");
@@ -49,18 +73,15 @@ std::vector<std::string> MidiInput::ports() {
 
 void MidiInput::openPort(int port) {
   const std::vector<std::string> names = ports();
-  if (port < 0 || port >= static_cast<int>(names.size())) {
-    std::string list;
-    for (size_t i = 0; i < names.size(); ++i)
-      list += (i ? "; " : "") + std::to_string(i) + ": " + names[i];
+  if (port < 0 || port >= static_cast<int>(names.size()))
     throw MidiError("--midi-port " + std::to_string(port) +
-                    ": no such MIDI input port; ports: " + (list.empty() ? "none" : list));
-  }
+                    ": no such MIDI input port; ports: " + portList(names));
   try {
     const QuietStderr quiet;
     impl_->in->setCallback(&MidiInput::arrived, this);
     impl_->in->openPort(static_cast<unsigned>(port), "hamiltone-in");
     impl_->open = true;
+    portName_ = names[static_cast<size_t>(port)];
   } catch (const RtMidiError& e) {
     throw MidiError("cannot open MIDI port " + std::to_string(port) + ": " + e.getMessage());
   }
@@ -75,6 +96,33 @@ void MidiInput::openVirtualPort(const std::string& name) {
   } catch (const RtMidiError& e) {
     throw MidiError("cannot create the virtual MIDI port \"" + name + "\": " + e.getMessage());
   }
+}
+
+bool MidiInput::portPresent() {
+  if (portName_.empty()) return true;
+  const QuietStderr quiet;
+  try {
+    if (!impl_->watcher)
+      impl_->watcher = std::make_unique<RtMidiIn>(
+          RtMidi::getCompiledApiByName(api_ == "pulse" ? "alsa" : api_), "hamiltone-watch");
+    const unsigned count = impl_->watcher->getPortCount();
+    for (unsigned i = 0; i < count; ++i)
+      if (stablePortName(impl_->watcher->getPortName(i)) == stablePortName(portName_)) return true;
+  } catch (const RtMidiError&) {
+    return true;  // cannot tell
+  }
+  return false;
+}
+
+void MidiInput::reconnect() {
+  const std::string name = portName_;
+  const std::vector<std::string> names = ports();
+  const auto found = std::find_if(names.begin(), names.end(), [&](const std::string& n) {
+    return stablePortName(n) == stablePortName(name);
+  });
+  if (found == names.end()) throw MidiError("MIDI input port \"" + name + "\" is not there");
+  close();
+  openPort(static_cast<int>(found - names.begin()));
 }
 
 void MidiInput::close() {

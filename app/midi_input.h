@@ -27,6 +27,13 @@ struct StampedMessage {
 
 std::int64_t steadyNanoseconds();
 
+// "0: NAME; 1: NAME …", or "none".
+std::string portList(const std::vector<std::string>& names);
+
+// A port's name without the " CLIENT:PORT" numbers RtMidi appends on ALSA ("Keystation 88:
+// Keystation 88 MIDI 1 24:0"), which a keyboard plugged in again may change.
+std::string stablePortName(const std::string& name);
+
 class MidiInput {
  public:
   static constexpr size_t kQueueSize = 4096;
@@ -38,6 +45,14 @@ class MidiInput {
   void openPort(int port);  // throws MidiError listing the ports
   void openVirtualPort(const std::string& name);
   void close();
+  // The port openPort() connected to ("" with none, or a virtual port), and whether it is still
+  // there — asked of a client of its own, from the main thread, polled. Names are compared without
+  // the client:port numbers ALSA's carry, which change when a keyboard is plugged in again.
+  const std::string& portName() const { return portName_; }
+  bool portPresent();
+  // Connects again to the port of that name (as portPresent() compares them), wherever it is now.
+  // Throws MidiError.
+  void reconnect();
 
   SpscQueue<StampedMessage>& queue() { return queue_; }
   long dropped() const { return dropped_.load(); }  // the queue was full
@@ -47,6 +62,7 @@ class MidiInput {
 
   struct Impl;
   std::unique_ptr<Impl> impl_;
+  std::string api_, portName_;
   SpscQueue<StampedMessage> queue_{kQueueSize};
   std::atomic<long> dropped_{0};
 };

@@ -1,5 +1,6 @@
-// hamiltone-play: plays presets live from a MIDI keyboard (or a virtual MIDI port) through the
-// sound card or a JACK server, optionally recording exactly what it plays.
+// hamiltone-play: plays presets live from a MIDI keyboard (or a virtual MIDI port), a MIDI file or
+// a --notes list through the sound card or a JACK server, optionally recording exactly what it
+// plays.
 #include <unistd.h>
 
 #include <CLI/App.hpp>
@@ -11,11 +12,15 @@
 #include <ctime>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "atomic_file.h"
 #include "audio_output.h"
+#include "limit_report.h"
+#include "midi/midi_file.h"
 #include "midi_input.h"
+#include "note_list.h"
 #include "number_arguments.h"
 #include "player.h"
 #include "preset_arguments.h"
@@ -29,9 +34,58 @@ namespace {
 struct PlayArguments {
   std::vector<std::string> presets, sets;
   std::string api = "jack", device, sampleRate = "48000", buffer = "128", midiPort, virtualMidi;
-  std::string record, voices, threads;
-  bool listDevices = false, quiet = false;
+  std::string record, voices, threads, midi, notes, cpuLimit = "80";
+  bool listDevices = false, quiet = false, keepListening = false;
 };
+
+// What --midi FILE or --notes LIST plays, read and checked before any device is opened.
+struct Score {
+  std::vector<TimedMessage> messages;
+  std::string what;  // "--midi FILE", "--notes"; "" with no score
+};
+
+Score readScore(const PlayArguments& a) {
+  if (!a.midi.empty() && !a.notes.empty())
+    throw cli::UsageError("give at most one of --midi FILE and --notes LIST");
+  Score score;
+  if (!a.midi.empty()) {
+    try {
+      score.messages = readMidiFile(a.midi).messages;
+    } catch (const MidiFileError& e) {  // "<file>: byte N: what is wrong", or "<file>: why"
+      throw cli::UsageError(std::string("--midi: ") + e.what());
+    }
+    score.what = "--midi " + a.midi;
+  } else if (!a.notes.empty()) {
+    score.messages = cli::parseNoteList(a.notes).messages;
+    score.what = "--notes";
+  }
+  return score;
+}
+
+// The rate to play at: --sample-rate's, unless the device or server runs at another, which is then
+// said in one line. Outside the engine's rates: AudioError.
+unsigned playingRate(AudioOutput& audio, int output, unsigned requested) {
+  const unsigned rate = chooseSampleRate(requested, audio.device(output));
+  const std::string server = audio.api() == "jack" ? "the JACK server" : "the audio device";
+  if (rate < 8000 || rate > 384000)
+    throw AudioError(server + " runs at " + std::to_string(rate) +
+                     " Hz; Hamiltone plays at 8000 … 384000 Hz");
+  if (rate != requested)
+    std::fprintf(stderr, "hamiltone-play: %s runs at %u Hz: playing at %u Hz, not %u\n",
+                 server.c_str(), rate, rate, requested);
+  return rate;
+}
+
+// No MIDI input port was asked for: what there is, and how to choose one.
+void warnNoMidiInput(MidiInput& midi) {
+  const std::vector<std::string> ports = midi.ports();
+  std::fprintf(stderr,
+               "hamiltone-play: warning: no MIDI input is connected, so no key will sound; %s; "
+               "choose one with --midi-port N, or make one with --virtual-midi NAME and connect "
+               "a keyboard to it (or play --midi FILE / --notes LIST)\n",
+               ports.empty() ? "there are no MIDI input ports"
+                             : ("MIDI input ports: " + portList(ports)).c_str());
+}
 
 constexpr int kExitUsage = cli::kExitUsage;
 constexpr int kExitAudioLost = 3;  // the audio server or device went away while playing
@@ -100,7 +154,8 @@ int play(const PlayArguments& a) {
   if (a.listDevices) return listDevices(a.api);
   if (!a.midiPort.empty() && !a.virtualMidi.empty())
     throw cli::UsageError("give at most one of --midi-port N and --virtual-midi NAME");
-  const int rate = static_cast<int>(cli::parseInteger("--sample-rate", a.sampleRate, 8000, 384000));
+  const auto requestedRate =
+      static_cast<unsigned>(cli::parseInteger("--sample-rate", a.sampleRate, 8000, 384000));
   unsigned buffer = static_cast<unsigned>(cli::parseInteger("--buffer", a.buffer, 16, 8192));
   const int device =
       a.device.empty() ? -1 : static_cast<int>(cli::parseInteger("--device", a.device, 0));
@@ -110,10 +165,16 @@ int play(const PlayArguments& a) {
       a.threads.empty()
           ? 0
           : static_cast<int>(cli::parseInteger("--threads", a.threads, 1, Synth::kMaxThreads));
+  const double cpuLimit = cli::parseReal("--cpu-limit", a.cpuLimit, cli::Range::positive, "%");
+  if (cpuLimit > 100.0) throw cli::UsageError("--cpu-limit = " + a.cpuLimit + ": at most 100 (%)");
+  const Score score = readScore(a);
+  if (a.keepListening && score.what.empty())
+    throw cli::UsageError("--keep-listening goes with --midi FILE or --notes LIST");
 
   std::vector<cli::InputFile> inputs;
   for (const std::string& file : a.presets) inputs.push_back({"--preset", file});
   if (a.presets.empty()) inputs.push_back({"--preset (the default)", HAMILTONE_DEFAULT_PRESET});
+  if (!a.midi.empty()) inputs.push_back({"--midi", a.midi});
   cli::refuseInputAsOutput("--record", a.record, inputs);
 
   // Every signal that would end the program stops it instead, completing the recording: they are
@@ -136,6 +197,7 @@ int play(const PlayArguments& a) {
 
   AudioOutput audio(a.api);  // AudioError: exit 2 with what exists
   const int output = audio.resolve(device);
+  const unsigned rate = playingRate(audio, output, requestedRate);
   MidiInput midi(a.api);
   Synth synth;
   try {
@@ -148,30 +210,52 @@ int play(const PlayArguments& a) {
   }
   synth.setPolyphony(voices);
   std::unique_ptr<Recorder> recorder;
-  if (!a.record.empty()) recorder = std::make_unique<Recorder>(a.record, rate);
-  Player player(synth, midi.queue(), recorder ? &recorder->ring() : nullptr, rate, 8192);
+  if (!a.record.empty()) recorder = std::make_unique<Recorder>(a.record, static_cast<int>(rate));
+  Player player(synth, midi.queue(), recorder ? &recorder->ring() : nullptr, rate, 8192,
+                cpuLimit / 100.0);
+  player.setScore(score.messages);
 
-  audio.open(output, static_cast<unsigned>(rate), buffer, [&player](float* out, int frames, bool) {
+  audio.open(output, rate, buffer, [&player](float* out, int frames, bool) {
     player.render(out, frames, steadyNanoseconds());
   });
+  if (audio.streamRate() != rate)
+    throw AudioError("the audio stream opened at " + std::to_string(audio.streamRate()) +
+                     " Hz, not the " + std::to_string(rate) + " Hz asked for");
   if (!a.virtualMidi.empty())
     midi.openVirtualPort(a.virtualMidi);
   else if (!a.midiPort.empty())
     midi.openPort(static_cast<int>(cli::parseInteger("--midi-port", a.midiPort, 0)));
+  else if (score.what.empty() || a.keepListening)
+    warnNoMidiInput(midi);
   if (recorder) recorder->start();
   audio.start();
 
   const bool status = !a.quiet && ::isatty(2);
   if (!a.quiet)
     std::fprintf(stderr,
-                 "hamiltone-play: %s, %d Hz, %u frames (%.1f ms), %d thread%s; Ctrl-C stops\n",
+                 "hamiltone-play: %s, %u Hz, %u frames (%.1f ms), %d thread%s%s%s; Ctrl-C stops\n",
                  a.api.c_str(), rate, buffer, 1000.0 * buffer / rate, synth.threads(),
-                 synth.threads() == 1 ? "" : "s");
+                 synth.threads() == 1 ? "" : "s", score.what.empty() ? "" : "; playing ",
+                 score.what.c_str());
+  LimitReport limits({.budget = cpuLimit / 100.0,
+                      .frames = static_cast<int>(buffer),
+                      .sampleRate = static_cast<double>(rate),
+                      .threads = synth.threads(),
+                      .cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency())),
+                      .polyphony = synth.polyphony(),
+                      .jack = a.api == "jack"});
+  const timespec started = [] {
+    timespec t{};
+    ::clock_gettime(CLOCK_MONOTONIC, &t);
+    return t;
+  }();
   timespec wait{0, 250'000'000};
-  int signal = -1;
-  bool recordingFailureShown = false, lost = false, scheduled = false;
+  int signal = -1, polls = 0;
+  bool recordingFailureShown = false, lost = false, scheduled = false, finished = false,
+       portGone = false;
   while (signal < 0) {
     signal = sigtimedwait(&stopSignals, nullptr, &wait);
+    if (signal >= 0) break;
     if (!scheduled && player.callbackThread()) {
       scheduled = true;
       const int refused = followCallbackScheduling(synth, *player.callbackThread());
@@ -182,9 +266,39 @@ int play(const PlayArguments& a) {
                      status ? "\n" : "", refused);
     }
     // A server that went away (JACK shuts its clients down) leaves nothing to play on.
-    if (signal < 0 && audio.lost()) {
+    if (audio.lost()) {
       lost = true;
       break;
+    }
+    const Player::Status s = player.status();
+    // The score played and its last key silent: done, unless asked to listen on.
+    if (s.finished && !a.keepListening) {
+      finished = true;
+      break;
+    }
+    timespec now{};
+    ::clock_gettime(CLOCK_MONOTONIC, &now);
+    const std::string limitLine = limits.update(
+        s, double(now.tv_sec - started.tv_sec) + 1e-9 * double(now.tv_nsec - started.tv_nsec));
+    if (!limitLine.empty())
+      std::fprintf(stderr, "%shamiltone-play: %s\n", status ? "\n" : "", limitLine.c_str());
+    // The keyboard's port, once a second: unplugged, or its program gone.
+    if (++polls % 4 == 0 && !midi.portName().empty() && midi.portPresent() == portGone) {
+      portGone = !portGone;
+      if (portGone)
+        std::fprintf(stderr,
+                     "%shamiltone-play: warning: the MIDI input port \"%s\" is gone, so no MIDI "
+                     "input is connected; MIDI input ports now: %s; it is connected again when it "
+                     "comes back, or restart with --midi-port N to choose another\n",
+                     status ? "\n" : "", midi.portName().c_str(), portList(midi.ports()).c_str());
+      else
+        try {
+          midi.reconnect();
+          std::fprintf(stderr, "%shamiltone-play: the MIDI input port \"%s\" is back: connected\n",
+                       status ? "\n" : "", midi.portName().c_str());
+        } catch (const MidiError&) {
+          portGone = true;  // tried again in a second
+        }
     }
     // A failed recording is said at once, on a line of its own; the sound plays on.
     if (recorder && recorder->failed() && !recordingFailureShown) {
@@ -196,7 +310,6 @@ int play(const PlayArguments& a) {
                    recorder->failedAtSeconds());
     }
     if (!status) continue;
-    const Player::Status s = player.status();
     std::fprintf(stderr,
                  "\r  voices %2d/%-3d  cpu %3.0f%% (peak %3.0f%%)  underruns %ld (late %ld)  "
                  "midi %-12s  guard %d%s   ",
@@ -217,10 +330,11 @@ int play(const PlayArguments& a) {
                  s.guardEvents);
   else
     std::fprintf(stderr,
-                 "hamiltone-play: stopped by %s; underruns %ld; late callbacks %ld; peak cpu "
+                 "hamiltone-play: %s; underruns %ld; late callbacks %ld; peak cpu "
                  "%.0f%%; guard events %d\n",
-                 signalName(signal).c_str(), audio.underruns(), s.late, 100.0 * s.peakLoad,
-                 s.guardEvents);
+                 finished ? ("played " + score.what + " to the end").c_str()
+                          : ("stopped by " + signalName(signal)).c_str(),
+                 audio.underruns(), s.late, 100.0 * s.peakLoad, s.guardEvents);
   if (recorder) {
     const double seconds = recorder->finish();
     if (!recorder->failed()) {
@@ -240,6 +354,7 @@ int play(const PlayArguments& a) {
     if (recorder->failed()) return 1;
   }
   if (lost) return kExitAudioLost;
+  if (finished) return 0;
   // The signals meant to stop a program end it normally; another is reported as a shell would.
   return signal == SIGINT || signal == SIGTERM || signal == SIGHUP ? 0 : 128 + signal;
 }
@@ -268,6 +383,18 @@ int main(int argc, char** argv) {
                        "MIDI input port (see --list-devices)");
   app.add_option("--virtual-midi", a.virtualMidi, "create a MIDI input port with this name")
       ->type_name("NAME");
+  app.add_option("--midi", a.midi,
+                 "also play this Standard MIDI File (format 0 or 1) live, from the start of the "
+                 "stream; the player exits when it has played and its last note died away")
+      ->type_name("FILE");
+  app.add_option("--notes", a.notes,
+                 "also play these notes live (a test chord), as hamiltone-render --notes: "
+                 "NOTE[@START][:VELOCITY[:DURATION]], comma-separated, e.g. \"C4, E4, G4\" "
+                 "(C4 = MIDI 60; START 0, VELOCITY 100 and DURATION 1 s by default); the player "
+                 "exits when they have died away")
+      ->type_name("LIST");
+  app.add_flag("--keep-listening", a.keepListening,
+               "after --midi or --notes, play on from MIDI input until stopped");
   app.add_option("--record", a.record, "also write what is played to this WAV file (24-bit)")
       ->type_name("FILE");
   cli::addNumberOption(&app, "--voices", a.voices, "N",
@@ -275,15 +402,20 @@ int main(int argc, char** argv) {
   cli::addNumberOption(&app, "--threads", a.threads, "N",
                        "threads rendering the keys, the audio callback's included, 1 … 256 "
                        "(default: one per core); the sound is the same whatever N");
+  cli::addNumberOption(&app, "--cpu-limit", a.cpuLimit, "PERCENT",
+                       "share of the buffer period the audio callback may take before the voice "
+                       "limit drops, above 0, at most 100");
   app.add_flag("--list-devices", a.listDevices, "list the APIs, output devices and MIDI ports");
   app.add_flag("--quiet", a.quiet, "no status line");
   app.footer(
       "Signals: SIGINT, SIGTERM and SIGHUP stop it normally; SIGUSR1, SIGPIPE, SIGALRM and the "
       "other signals that would end it stop it too, completing the recording, and exit 128+N; "
       "a signal ignored when it starts (nohup) stays ignored. "
-      "Exit codes: 0 stopped by SIGINT/SIGTERM/SIGHUP (the recording is complete), 1 an I/O error "
+      "Exit codes: 0 stopped by SIGINT/SIGTERM/SIGHUP, or --midi/--notes played to the end (the "
+      "recording is complete), 1 an I/O error "
       "(a recording that failed, e.g. on a full disk, keeps what was written before the error), "
-      "2 bad input or no usable audio API/device, 3 the audio server or device went away while "
+      "2 bad input (arguments, preset, MIDI file) or no usable audio API/device, 3 the audio "
+      "server or device went away while "
       "playing (the recording is complete up to then).");
   try {
     app.parse(argc, argv);

@@ -1,5 +1,6 @@
-// The callback's work: drain the MIDI queue onto sample offsets, run the synthesizer, interleave,
-// tee into the recording ring, measure the load and lower or restore the voice limit.
+// The callback's work: drain the MIDI queue onto sample offsets, merge in the score's messages
+// due in the block, run the synthesizer, interleave, tee into the recording ring, measure the load
+// and lower or restore the voice limit.
 #include "player.h"
 
 #include <algorithm>
@@ -9,7 +10,7 @@
 namespace hamiltone::app {
 
 Player::Player(Synth& synth, SpscQueue<StampedMessage>& midi, SpscQueue<float>* record,
-               double sampleRate, int maxFrames)
+               double sampleRate, int maxFrames, double overload)
     : synth_(synth),
       midi_(midi),
       record_(record),
@@ -17,9 +18,34 @@ Player::Player(Synth& synth, SpscQueue<StampedMessage>& midi, SpscQueue<float>* 
       left_(maxFrames),
       right_(maxFrames),
       events_(kMaxEventsPerBlock),
+      scored_(kMaxEventsPerBlock),
+      merged_(2 * kMaxEventsPerBlock),
+      overload_(overload),
       fullLimit_(synth.polyphony()),
       limit_(synth.polyphony()) {
   limitShown_ = limit_;
+}
+
+void Player::setScore(std::span<const TimedMessage> score) {
+  score_.clear();
+  score_.reserve(score.size());
+  for (const TimedMessage& m : score)
+    score_.push_back({std::llround(m.seconds * sampleRate_), m.message});
+  nextScored_ = 0;
+}
+
+// The score's messages due before the block's end, at their offsets (one due before the block —
+// left over from a full block — at its first sample).
+int Player::scoreEvents(int frames) noexcept {
+  int count = 0;
+  const std::int64_t end = position_ + frames;
+  while (count < kMaxEventsPerBlock && nextScored_ < score_.size() &&
+         score_[nextScored_].sample < end) {
+    const ScoreEvent& e = score_[nextScored_++];
+    scored_[count++] = {static_cast<int>(std::max<std::int64_t>(0, e.sample - position_)),
+                        e.message};
+  }
+  return count;
 }
 
 void Player::render(float* interleaved, int frames, std::int64_t nowNs) noexcept {
@@ -44,8 +70,20 @@ void Player::render(float* interleaved, int frames, std::int64_t nowNs) noexcept
     midi_.drop();
   }
   // Arrivals come in order, so the offsets (clamped or not) never decrease: no sort is needed.
+  // The score's are in order too: the two lists merge (live first at equal offsets).
+  std::span<const SynthEvent> events(events_.data(), count);
+  if (nextScored_ < score_.size()) {
+    const int scored = scoreEvents(frames);
+    const auto byOffset = [](const SynthEvent& a, const SynthEvent& b) {
+      return a.offset < b.offset;
+    };
+    const auto end = std::merge(events_.begin(), events_.begin() + count, scored_.begin(),
+                                scored_.begin() + scored, merged_.begin(), byOffset);
+    events = std::span<const SynthEvent>(merged_.data(), end - merged_.begin());
+  }
   std::span<float> left(left_.data(), frames), right(right_.data(), frames);
-  synth_.process(left, right, std::span(events_.data(), count));
+  synth_.process(left, right, events);
+  position_ += frames;
   for (int i = 0; i < frames; ++i) {
     interleaved[2 * i] = left[i];
     interleaved[2 * i + 1] = right[i];
@@ -62,22 +100,50 @@ void Player::render(float* interleaved, int frames, std::int64_t nowNs) noexcept
   protect(load, period);
   load_.store(load, std::memory_order_relaxed);
   if (load > peak_.load(std::memory_order_relaxed)) peak_.store(load, std::memory_order_relaxed);
-  voices_.store(synth_.activeVoices(), std::memory_order_relaxed);
+  const int voices = synth_.activeVoices();
+  voices_.store(voices, std::memory_order_relaxed);
   guard_.store(synth_.guardEvents(), std::memory_order_relaxed);
+  if (!score_.empty() && nextScored_ == score_.size() && voices == 0)
+    finished_.store(true, std::memory_order_relaxed);
 }
 
-// Near the deadline the limit drops by one (the synth fades the keys furthest below their own
-// peak first); after a second under kRelief it rises by one, back to the preset's polyphony.
+// Near the deadline — kOverloadedBlocks blocks in a row over the budget, with keys sounding — the
+// limit drops by one below the keys sounding (the synth fades the key furthest below its own peak
+// first), then holds for kHoldSeconds, so that the fade is over and its effect measured before it
+// may drop again; never below the floor. After a second under kRelief it rises by one, back to the
+// preset's polyphony.
+//
+// It once dropped on any single late block, to one below the keys sounding and at least 1: a
+// block made late by the host (a busy JACK server's other clients, a page fault) with no key
+// sounding set the limit to 1 at once, and a real overload took it a key per block down to 1,
+// since a key fading out (5 ms) is no longer counted but still costs its time — and then it came
+// back a key per second at best.
 void Player::protect(double load, double blockSeconds) noexcept {
-  if (load > kOverload && limit_ > 1) {
-    limit_ = std::max(1, std::min(limit_, synth_.activeVoices()) - 1);
-    synth_.setPolyphony(limit_);
+  const int floor = std::min(fullLimit_, kFloorVoices);
+  holdTime_ = std::max(0.0, holdTime_ - blockSeconds);
+  if (load > overload_) {
     reliefTime_ = 0.0;
-  } else if (load < kRelief && limit_ < fullLimit_) {
-    reliefTime_ += blockSeconds;
-    if (reliefTime_ >= 1.0) {
-      synth_.setPolyphony(++limit_);
-      reliefTime_ = 0.0;
+    runPeak_ = overloadedRun_ == 0 ? load : std::max(runPeak_, load);
+    ++overloadedRun_;
+    const int active = synth_.activeVoices();
+    const int lowered = std::max(floor, std::min(limit_, active) - 1);
+    if (overloadedRun_ >= kOverloadedBlocks && holdTime_ <= 0.0 &&
+        lowered < std::min(limit_, active)) {  // a key goes {
+      limit_ = lowered;
+      synth_.setPolyphony(limit_);
+      holdTime_ = kHoldSeconds;
+      overloadedRun_ = 0;
+      dropLoad_.store(runPeak_, std::memory_order_relaxed);
+      drops_.fetch_add(1, std::memory_order_relaxed);
+    }
+  } else {
+    overloadedRun_ = 0;
+    if (load < kRelief && limit_ < fullLimit_) {
+      reliefTime_ += blockSeconds;
+      if (reliefTime_ >= 1.0) {
+        synth_.setPolyphony(++limit_);
+        reliefTime_ = 0.0;
+      }
     }
   }
   limitShown_.store(limit_, std::memory_order_relaxed);
@@ -98,6 +164,9 @@ Player::Status Player::status() const {
   s.recordDropped = recordDropped_.load();
   s.late = late_.load();
   s.lastMessage = last_.load();
+  s.limitDrops = drops_.load();
+  s.dropLoad = dropLoad_.load();
+  s.finished = finished_.load();
   return s;
 }
 

@@ -1,5 +1,6 @@
 // The audio callback's work, apart from any audio API (so it can be tested and sanitised alone):
-// MIDI from the queue placed on the block's samples, the synthesizer, the recording tee, the load
+// MIDI from the queue placed on the block's samples, a score (a MIDI file or --notes, parsed
+// beforehand) played from the stream's first sample, the synthesizer, the recording tee, the load
 // measurement and the overload protection. Real-time safe: no allocation, lock, I/O or syscall
 // beyond reading the steady clock and waking the synthesizer's sleeping workers (sem_post).
 #pragma once
@@ -9,6 +10,7 @@
 #include <atomic>
 #include <cstdint>
 #include <optional>
+#include <span>
 
 #include "midi_input.h"
 #include "synth/nonblocking.h"
@@ -19,13 +21,26 @@ namespace hamiltone::app {
 
 class Player {
  public:
-  static constexpr int kMaxEventsPerBlock = 1024;  // more wait for the next block
-  static constexpr double kOverload = 0.8;         // of the buffer period: drop a voice
+  static constexpr int kMaxEventsPerBlock = 1024;  // of each source; more wait for the next block
+  static constexpr double kOverload = 0.8;         // of the buffer period: drop a voice (default)
   static constexpr double kRelief = 0.5;           // below this for 1 s: allow one more
+  // Overload protection (protect()): the limit drops only after kOverloadedBlocks blocks in a
+  // row over the budget with keys sounding, by one key, then waits kHoldSeconds (the stolen key's
+  // 5 ms fade and the blocks after it) before it may drop again, and never below kFloorVoices
+  // (or the polyphony, if lower): a late block on a busy server, with or without keys sounding,
+  // no longer takes it down to one key.
+  static constexpr int kOverloadedBlocks = 2;
+  static constexpr double kHoldSeconds = 0.05;
+  static constexpr int kFloorVoices = 4;
 
   // `record` may be null. The synth must be prepared for blocks of at least `maxFrames`.
+  // `overload`: the share of the buffer period above which the protection drops a key.
   Player(Synth& synth, SpscQueue<StampedMessage>& midi, SpscQueue<float>* record, double sampleRate,
-         int maxFrames);
+         int maxFrames, double overload = kOverload);
+
+  // A score to play from the first rendered sample on: messages in time order, at their time in
+  // seconds rounded to the sample. Before the first render() (it allocates); replaces any other.
+  void setScore(std::span<const TimedMessage> score);
 
   // Fills `frames` interleaved stereo frames. A message that arrived a time d before `nowNs`
   // lands d·rate samples before the end of this block: a constant latency of one buffer, and
@@ -40,6 +55,11 @@ class Player {
     long recordDropped = 0;         // samples the recording ring had no room for
     long late = 0;                  // blocks whose compute time exceeded their period
     std::uint32_t lastMessage = 0;  // status << 16 | data1 << 8 | data2; 0 before any
+    long limitDrops = 0;            // times the protection lowered the limit
+    double dropLoad = 0.0;          // the highest load of the blocks that made it drop last
+    // The score has been played to its last message and no key sounds any more (false with no
+    // score).
+    bool finished = false;
   };
   Status status() const;  // from any thread
   // The thread that ran the first render(), once there was one: the audio API's callback thread.
@@ -47,18 +67,29 @@ class Player {
 
  private:
   void protect(double load, double blockSeconds) noexcept;
+  int scoreEvents(int frames) noexcept;  // the score's messages in this block, into scored_
+
+  struct ScoreEvent {
+    std::int64_t sample;
+    MidiMessage message;
+  };
 
   Synth& synth_;
   SpscQueue<StampedMessage>& midi_;
   SpscQueue<float>* record_;
   double sampleRate_;
   std::vector<float> left_, right_;
-  std::vector<SynthEvent> events_;
-  int fullLimit_ = 0, limit_ = 0;
-  double reliefTime_ = 0.0;
+  std::vector<SynthEvent> events_, scored_, merged_;
+  std::vector<ScoreEvent> score_;
+  size_t nextScored_ = 0;
+  std::int64_t position_ = 0;  // samples rendered
+  double overload_;
+  int fullLimit_ = 0, limit_ = 0, overloadedRun_ = 0;
+  double reliefTime_ = 0.0, holdTime_ = 0.0, runPeak_ = 0.0;
   std::atomic<int> voices_{0}, limitShown_{0}, guard_{0};
-  std::atomic<double> load_{0.0}, peak_{0.0};
-  std::atomic<long> recordDropped_{0}, late_{0};
+  std::atomic<double> load_{0.0}, peak_{0.0}, dropLoad_{0.0};
+  std::atomic<long> recordDropped_{0}, late_{0}, drops_{0};
+  std::atomic<bool> finished_{false};
   std::atomic<std::uint32_t> last_{0};
   pthread_t callbackThread_{};  // written once, before callbackKnown_
   std::atomic<bool> callbackKnown_{false};

@@ -1,12 +1,13 @@
-// hamiltone-play's command line where no audio device is needed: presets, every --set and the
-// --record target are checked before any device is opened, so a bad one is refused (exit 2, one
-// message naming it, files left as they were) and a good one gets as far as the audio API — here
-// a JACK server that does not exist.
+// hamiltone-play's command line where no audio device is needed: presets, every --set, the
+// --record target, --midi's file and --notes' list are checked before any device is opened, so a
+// bad one is refused (exit 2, one message naming it, files left as they were) and a good one gets
+// as far as the audio API — here a JACK server that does not exist.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <utility>
 
@@ -84,6 +85,59 @@ TEST_F(PlayCli, RefusesToRecordOntoAPreset) {
     EXPECT_NE(r.err.find("--record = " + out.string()), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("--preset = " + toml.string()), std::string::npos) << r.err;
     EXPECT_EQ(hamiltone::testing::fileBytes(toml), before);
+  }
+}
+
+// --midi FILE: a file that is missing or is not a Standard MIDI File is refused before any device,
+// naming the file and what is wrong, as hamiltone-render says it.
+TEST_F(PlayCli, RefusesAMissingOrCorruptMidiFile) {
+  const fs::path corrupt = dir_ / "corrupt.mid", missing = dir_ / "missing.mid";
+  std::ofstream(corrupt) << "MThd this is not MIDI";
+  for (const auto& [file, mention] :
+       {std::pair<fs::path, std::string>{missing, "--midi: " + missing.string() + ": "},
+        {corrupt, "--midi: " + corrupt.string() + ": byte "}}) {
+    const CommandResult r = play("--quiet --midi " + file.string());
+    EXPECT_EQ(r.exitCode, 2) << file << "\n" << r.err;
+    EXPECT_NE(r.err.find(mention), std::string::npos) << file << "\n" << r.err;
+    EXPECT_EQ(r.err.find("audio"), std::string::npos) << file << "\n" << r.err;
+  }
+}
+
+// --notes takes hamiltone-render's list, and refuses a bad one with the renderer's message.
+TEST_F(PlayCli, RefusesABadNoteListAsTheRendererDoes) {
+  for (const auto& [notes, mention] :
+       {std::pair<std::string, std::string>{"H4", "--notes: item 1 \"H4\": unknown note name"},
+        {"C4,,E4", "--notes: item 2 \"\": empty"},
+        {"C4:200", "--notes: item 1 \"C4:200\": velocity"},
+        {"C4@-1", "--notes: item 1 \"C4@-1\": start"}}) {
+    const CommandResult r = play("--quiet --notes '" + notes + "'");
+    EXPECT_EQ(r.exitCode, 2) << notes << "\n" << r.err;
+    EXPECT_NE(r.err.find(mention), std::string::npos) << notes << "\n" << r.err;
+  }
+}
+
+TEST_F(PlayCli, RefusesConflictingOrOutOfRangeOptions) {
+  for (const auto& [args, mention] :
+       {std::pair<std::string, std::string>{"--notes C4 --midi x.mid",
+                                            "at most one of --midi FILE and --notes LIST"},
+        {"--keep-listening", "--keep-listening goes with --midi FILE or --notes LIST"},
+        {"--cpu-limit 0", "--cpu-limit = 0"},
+        {"--cpu-limit 101", "--cpu-limit = 101: at most 100"}}) {
+    const CommandResult r = play("--quiet " + args);
+    EXPECT_EQ(r.exitCode, 2) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find(mention), std::string::npos) << args << "\n" << r.err;
+  }
+}
+
+// A good --notes list or MIDI file gets as far as the audio API.
+TEST_F(PlayCli, AcceptsNotesAndAMidiFileAndGoesOnToTheAudioDevice) {
+  const std::string demo = std::string(HAMILTONE_SOURCE_DIR) + "/presets/demo.mid";
+  for (const std::string& args :
+       {std::string("--notes 'C4, E4@0.5:80, G4@1:100:2.5' --cpu-limit 95"),
+        "--midi " + demo + " --keep-listening"}) {
+    const CommandResult r = play("--quiet " + args);
+    EXPECT_EQ(r.exitCode, 2) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find("no audio output device for API jack"), std::string::npos) << r.err;
   }
 }
 

@@ -220,31 +220,66 @@ TEST(Player, KnowsTheThreadOfItsCallback) {
 // same player, which no claimed rate gives, so it is not tested here. With workers the load still
 // ends with the block's last key, as Synth::process returns only once every key is rendered.
 
-TEST(Player, OverloadLowersTheVoiceLimitOneAtATimeToOneAtLeast) {
-  constexpr int kFrames = 64, kPolyphony = 4;
+// A budget of a nanosecond's share of the period makes every block overloaded, on the real rate's
+// clock, so the hold after each drop passes as it does live.
+constexpr double kNoBudget = 1e-9;
+
+// Overloaded block after block with 8 keys sounding: nothing on the first block (a single late
+// block, as a busy server gives, is no overload), then one key at a time, kHoldSeconds apart (the
+// key fading out is measured gone first), down to the floor of kFloorVoices and no further.
+TEST(Player, OverloadLowersTheVoiceLimitOneKeyPerHoldDownToTheFloor) {
+  constexpr int kFrames = 64, kPolyphony = 8;
+  const double hold = Player::kHoldSeconds * kRate / kFrames;  // blocks
   for (int threads : {1, 3}) {  // on the callback's thread alone, and with two workers
     SCOPED_TRACE(std::to_string(threads) + " threads");
     Synth synth = prepared({pianoKeys(48, 55, kPolyphony)}, kRate, threads);
     SpscQueue<StampedMessage> midi(16);
-    Player player(synth, midi, nullptr, 1e9, kFrames);
+    Player player(synth, midi, nullptr, kRate, kFrames, kNoBudget);
     EXPECT_EQ(player.status().limit, kPolyphony);
     for (int note = 48; note < 48 + kPolyphony; ++note)
       ASSERT_TRUE(midi.push({0, {0x90, uint8_t(note), 100}}));
     std::vector<float> interleaved(2 * kFrames);
+    std::vector<int> dropsAt;
     int limit = kPolyphony;
-    for (int block = 0; block < 2 * kPolyphony; ++block) {
+    for (int block = 0; block < std::lround(6 * hold); ++block) {
       player.render(interleaved.data(), kFrames, 0);
       const Player::Status status = player.status();
-      EXPECT_GT(status.load, Player::kOverload);
+      EXPECT_GT(status.load, kNoBudget);
       EXPECT_GE(status.peakLoad, status.load);
-      EXPECT_EQ(status.limit, std::max(1, limit - 1)) << "block " << block;
       EXPECT_EQ(synth.polyphony(), status.limit);
       EXPECT_LE(status.voices, status.limit);
       EXPECT_EQ(status.voices, synth.activeVoices());
-      limit = status.limit;
+      if (status.limit != limit) {
+        EXPECT_EQ(status.limit, limit - 1) << "block " << block;
+        EXPECT_GT(status.dropLoad, kNoBudget);
+        dropsAt.push_back(block);
+        limit = status.limit;
+      }
+      EXPECT_EQ(status.limitDrops, static_cast<long>(dropsAt.size()));
     }
-    EXPECT_EQ(limit, 1);
+    EXPECT_EQ(limit, Player::kFloorVoices);
+    ASSERT_EQ(dropsAt.size(), size_t{kPolyphony - Player::kFloorVoices});
+    EXPECT_EQ(dropsAt[0], Player::kOverloadedBlocks - 1);
+    for (size_t k = 1; k < dropsAt.size(); ++k) EXPECT_GE(dropsAt[k] - dropsAt[k - 1], hold);
   }
+}
+
+// The host's load, not the keys': overloaded blocks with no key sounding, or fewer keys than the
+// floor, leave the limit alone (it went to 1 at the first late block).
+TEST(Player, OverloadWithoutKeysToTakeLeavesTheLimitAlone) {
+  constexpr int kFrames = 64, kPolyphony = 8;
+  Synth synth = prepared({pianoKeys(48, 55, kPolyphony)});
+  SpscQueue<StampedMessage> midi(16);
+  Player player(synth, midi, nullptr, kRate, kFrames, kNoBudget);
+  std::vector<float> interleaved(2 * kFrames);
+  for (int block = 0; block < 100; ++block) {
+    for (int note = 48; block == 50 && note < 48 + Player::kFloorVoices; ++note)
+      ASSERT_TRUE(midi.push({0, {0x90, uint8_t(note), 100}}));
+    player.render(interleaved.data(), kFrames, 0);
+    EXPECT_EQ(player.status().limit, kPolyphony) << "block " << block;
+    EXPECT_EQ(player.status().limitDrops, 0);
+  }
+  EXPECT_EQ(synth.activeVoices(), Player::kFloorVoices);
 }
 
 TEST(Player, UnderLightLoadTheLimitStaysAtThePresetsPolyphony) {
@@ -269,6 +304,78 @@ TEST(Player, UnderLightLoadTheLimitStaysAtThePresetsPolyphony) {
     }
     EXPECT_EQ(player.status().lastMessage, 0x90u << 16 | 53u << 8 | 100u);
   }
+}
+
+// --- The score (--midi, --notes) -----------------------------------------------------------------
+
+// The score's messages land on the sample their time gives, counted from the first rendered
+// sample, merged in order with the queue's: the output equals the synth's own with the same
+// events at those offsets, in blocks of any size.
+TEST(Player, ScoreMessagesLandOnTheirSamplesMergedWithLiveOnes) {
+  const TimedMessage score[] = {{0.0, {0x90, 48, 90}},
+                                {100.0 / kRate, {0x90, 50, 70}},
+                                {300.0 / kRate, {0xB0, 64, 127}},
+                                {300.0 / kRate, {0x90, 52, 127}},
+                                {700.0 / kRate, {0x80, 48, 0}},
+                                {1000.0 / kRate, {0x90, 51, 100}}};
+  constexpr int kFrames = 256, kBlocks = 5;
+  // Live: arrived 56 samples before the end of the second block, i.e. at its sample 200.
+  const MidiMessage live{0x90, 49, 110};
+  const std::pair<long, MidiMessage> all[] = {{0, score[0].message},   {100, score[1].message},
+                                              {300, score[2].message}, {300, score[3].message},
+                                              {256 + 200, live},       {700, score[4].message},
+                                              {1000, score[5].message}};
+  Synth reference = prepared({pianoKeys(48, 52)});
+  std::vector<float> l(kFrames * kBlocks), r(kFrames * kBlocks);
+  for (int b = 0; b < kBlocks; ++b) {
+    std::vector<SynthEvent> events;
+    for (const auto& [sample, message] : all)
+      if (sample / kFrames == b) events.push_back({static_cast<int>(sample % kFrames), message});
+    reference.process(std::span(l).subspan(b * kFrames, kFrames),
+                      std::span(r).subspan(b * kFrames, kFrames), events);
+  }
+
+  Synth synth = prepared({pianoKeys(48, 52)});
+  SpscQueue<StampedMessage> midi(16);
+  Player player(synth, midi, nullptr, kRate, kFrames);
+  player.setScore(score);
+  std::vector<float> interleaved(2 * kFrames);
+  for (int b = 0; b < kBlocks; ++b) {
+    const std::int64_t now = kNow + nanoseconds(b * kFrames / kRate);
+    if (b == 1) {
+      ASSERT_TRUE(midi.push({now - nanoseconds(56 / kRate), live}));
+    }
+    player.render(interleaved.data(), kFrames, now);
+    for (int i = 0; i < kFrames; ++i) {
+      ASSERT_EQ(interleaved[2 * i], l[b * kFrames + i]) << "block " << b << ", frame " << i;
+      ASSERT_EQ(interleaved[2 * i + 1], r[b * kFrames + i]) << "block " << b << ", frame " << i;
+    }
+  }
+}
+
+// Finished once the score's last message is played and no key sounds: here all sound off at
+// 0.05 s (the keys fade in 5 ms, and a fading key no longer counts).
+TEST(Player, FinishedOnceTheScoreIsPlayedAndSilent) {
+  constexpr int kFrames = 256;
+  const TimedMessage score[] = {
+      {0.0, {0x90, 48, 100}}, {0.01, {0x80, 48, 0}}, {0.05, {0xB0, 120, 0}}};
+  Synth synth = prepared({pianoKeys(48, 52)});
+  SpscQueue<StampedMessage> midi(16);
+  Player player(synth, midi, nullptr, kRate, kFrames);
+  EXPECT_FALSE(player.status().finished);
+  player.setScore(score);
+  std::vector<float> interleaved(2 * kFrames);
+  const long last = std::lround(0.05 * kRate) / kFrames;  // the block that holds all sound off
+  for (long b = 0; b <= last; ++b) {
+    EXPECT_FALSE(player.status().finished) << "block " << b;
+    player.render(interleaved.data(), kFrames, kNow);
+  }
+  EXPECT_TRUE(player.status().finished);
+
+  // Without a score a player never finishes.
+  Player live(synth, midi, nullptr, kRate, kFrames);
+  live.render(interleaved.data(), kFrames, kNow);
+  EXPECT_FALSE(live.status().finished);
 }
 
 }  // namespace

@@ -2,7 +2,9 @@
 // sound card), the player on its own virtual MIDI port, a scripted performance from
 // tests/e2e/midi_sender (a JACK MIDI client), and the recording checked for what a listener hears —
 // every note on time, in tune and on the instrument its program selects — with no underrun and
-// exit code 0; and, with no server, the player's one-line refusal and exit code 2.
+// exit code 0; --notes and --midi played live to their end, on pitch at the server's rate (44.1
+// and 96 kHz); the warnings for no MIDI input and a port that goes, and the line that says why
+// the voice limit dropped; and, with no server, the player's one-line refusal and exit code 2.
 //
 // Every process is started here and stopped by its PID; the server has a name of its own
 // (jackd -n, JACK_DEFAULT_SERVER for the clients), so a developer's JACK server is never touched
@@ -37,6 +39,7 @@
 extern char** environ;
 
 #include "support/child_process.h"
+#include "support/midi_writer.h"
 #include "support/recording.h"
 #include "support/sent_score.h"
 #include "support/spectrum.h"
@@ -147,11 +150,12 @@ class JackPlay : public ::testing::Test {
 
   fs::path wav() const { return dir_ / "out.wav"; }
 
-  // A server of its own (server_) on the dummy driver, answering. Fatal failure otherwise.
-  void startServer(bool realtime) {
+  // A server of its own (server_) on the dummy driver at `rate`, answering. Fatal failure
+  // otherwise.
+  void startServer(bool realtime, int rate = 48000) {
     spawn(jackd_,
           {"jackd", "-n", server_, realtime ? "--realtime" : "--no-realtime", "-d", "dummy", "-r",
-           "48000", "-p", std::to_string(kPeriod)},
+           std::to_string(rate), "-p", std::to_string(kPeriod)},
           "jackd");
     ASSERT_TRUE(jackd_->started());
     const Clock::time_point deadline = Clock::now() + 15s;
@@ -182,6 +186,22 @@ class JackPlay : public ::testing::Test {
     ASSERT_NE(list.find(":hamiltone-in"), std::string::npos)
         << "the player's MIDI port did not appear:\n"
         << slurp(dir_ / "player.err");
+  }
+
+  // The player on the server with `extra` arguments, recording to wav(), until it ends by itself
+  // (within 60 s): its exit code, or nothing.
+  std::optional<int> playToTheEnd(const std::vector<std::string>& extra) {
+    std::vector<std::string> argv = {HAMILTONE_PLAY, "--api", "jack", "--record", wav().string()};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    spawn(player_, argv, "player");
+    return player_->wait(60.0);
+  }
+
+  // Waits (10 s at most) until the player's stderr holds `text`; whether it does.
+  bool playerSays(const std::string& text) {
+    for (int i = 0; i < 100 && slurp(dir_ / "player.err").find(text) == std::string::npos; ++i)
+      std::this_thread::sleep_for(100ms);
+    return slurp(dir_ / "player.err").find(text) != std::string::npos;
   }
 
   // A server of its own, the player on it (its keys rendered on 2 threads: the audio callback
@@ -439,6 +459,160 @@ TEST_F(JackPlay, WithoutAServerRefusesInOneLineWithExitCode2) {
   EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
   EXPECT_EQ(err.back(), '\n') << err;
   EXPECT_NE(err.find("no audio output device for API jack"), std::string::npos) << err;
+}
+
+// The pitch of `key` in the recording at `rate`, over `seconds` from 0.2 s after its onset at or
+// after `from`, in cents from equal temperament; the onset is returned through `at`.
+double centsOff(const std::vector<double>& x, double rate, int key, long from, double seconds,
+                long& at) {
+  const std::vector<double> e = envelope(x);
+  at = onset(e, from, static_cast<long>(x.size()) - 1);
+  if (at < 0) return std::numeric_limits<double>::quiet_NaN();
+  const long start = at + std::lround(0.2 * rate), length = std::lround(seconds * rate);
+  if (start + length > static_cast<long>(x.size())) return std::numeric_limits<double>::quiet_NaN();
+  const std::span<const double> steady(x.data() + start, static_cast<size_t>(length));
+  const double hz = 440.0 * std::pow(2.0, (key - 69) / 12.0);
+  return cents(hamiltone::testing::peakFrequency(steady, hz, rate, 30.0), hz);
+}
+
+// A JACK server at 44.1 or 96 kHz: the player plays there instead of failing, says so in one line,
+// and --notes comes out on pitch (a note played at a wrong rate is off by 147 or 1350 cents); it
+// ends by itself, exit 0, once the note has died away. Within 3 cents as in the performance above.
+TEST_F(JackPlay, NotesPlayOnPitchAtTheServersRateAndEnd) {
+  if (!onPath("jackd") || !onPath("jack_lsp"))
+    GTEST_SKIP() << "jackd (Debian's jackd2) is not installed";
+  for (const int rate : {44100, 96000}) {
+    SCOPED_TRACE(std::to_string(rate) + " Hz");
+    stopAll();
+    useServer(name_ + "-" + std::to_string(rate));
+    ASSERT_NO_FATAL_FAILURE(startServer(false, rate));
+    const std::optional<int> code =
+        playToTheEnd({"--preset", HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml", "--notes",
+                      "A4:80:1.5", "--threads", "2"});
+    const std::string err = slurp(dir_ / "player.err");
+    EXPECT_EQ(code, 0) << err;
+    const std::string r = std::to_string(rate);
+    EXPECT_NE(err.find("the JACK server runs at " + r + " Hz: playing at " + r + " Hz, not 48000"),
+              std::string::npos)
+        << err;
+    EXPECT_NE(err.find("played --notes to the end"), std::string::npos) << err;
+    EXPECT_EQ(err.find("no MIDI input"), std::string::npos) << err;  // a score needs none
+    SF_INFO info;
+    const std::vector<double> x = readMono(wav(), info);
+    ASSERT_EQ(info.samplerate, rate);
+    long at = -1;
+    const double off = centsOff(x, rate, 69, 0, 1.2, at);
+    EXPECT_NEAR(off, 0.0, 3.0);
+    std::printf("%d Hz: A4 %+.3f cents, %.2f s recorded\n", rate, off,
+                static_cast<double>(x.size()) / rate);
+    jackd_->signal(SIGTERM);
+    jackd_->wait(10.0);
+  }
+}
+
+// --midi FILE: played live from the stream's first sample, its events on their samples (the file's
+// note at 0.5 s starts there, to the hammer's few milliseconds, whatever the wall clock did), and
+// the player ends by itself, exit 0, after the last note died away.
+TEST_F(JackPlay, MidiFilePlaysOnItsSamplesAndEnds) {
+  if (!onPath("jackd") || !onPath("jack_lsp"))
+    GTEST_SKIP() << "jackd (Debian's jackd2) is not installed";
+  using hamiltone::testing::TrackWriter;
+  // 480 ticks a quarter at the default 120 bpm: a tick is 1/960 s. C4 from 0.5 s to 2 s.
+  TrackWriter track;
+  track.event(0, {0xC0, 0}).event(480, {0x90, 60, 90}).event(1440, {0x80, 60, 0}).endOfTrack(0);
+  const fs::path midi = dir_ / "c4.mid";
+  const hamiltone::testing::Bytes bytes = hamiltone::testing::midiFile(0, 480, {track});
+  std::ofstream(midi, std::ios::binary)
+      .write(reinterpret_cast<const char*>(bytes.data()),
+             static_cast<std::streamsize>(bytes.size()));
+  ASSERT_NO_FATAL_FAILURE(startServer(false));
+  const std::optional<int> code = playToTheEnd(
+      {"--preset", HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml", "--midi", midi.string()});
+  const std::string err = slurp(dir_ / "player.err");
+  EXPECT_EQ(code, 0) << err;
+  EXPECT_NE(err.find("played --midi " + midi.string() + " to the end"), std::string::npos) << err;
+  SF_INFO info;
+  const std::vector<double> x = readMono(wav(), info);
+  ASSERT_EQ(info.samplerate, 48000);
+  long at = -1;
+  const double off = centsOff(x, kRate, 60, 0, 1.2, at);
+  EXPECT_GE(at, 24000);
+  EXPECT_LT(at, 24000 + 480) << "the note starts " << (at - 24000) / kRate << " s late";
+  EXPECT_NEAR(off, 0.0, 3.0);
+  EXPECT_LT(x.size(), static_cast<size_t>(10 * kRate));  // it ended after the tail, not later
+}
+
+// No MIDI input asked for: a warning naming the ports there are and how to choose one. A port
+// chosen with --midi-port that goes away (its client ends) is warned of, and connected again when
+// it comes back. Not fatal: the player plays on and stops on SIGINT with exit 0.
+TEST_F(JackPlay, WarnsOfNoMidiInputAndOfAPortThatGoes) {
+  if (!onPath("jackd") || !onPath("jack_lsp") || !onPath("jack_midiseq"))
+    GTEST_SKIP() << "jackd and jack_midiseq (Debian's jackd2) are not installed";
+  ASSERT_NO_FATAL_FAILURE(startServer(false));
+  const std::string paper = HAMILTONE_SOURCE_DIR "/presets/paper-c3-string.toml";
+  spawn(player_, {HAMILTONE_PLAY, "--api", "jack", "--quiet", "--preset", paper}, "player");
+  EXPECT_TRUE(
+      playerSays("warning: no MIDI input is connected, so no key will sound; there are "
+                 "no MIDI input ports; choose one with --midi-port N"));
+  player_->signal(SIGINT);
+  EXPECT_EQ(player_->wait(30.0), 0) << slurp(dir_ / "player.err");
+
+  // A keyboard: jack_midiseq's output port, playing C3 every second.
+  std::optional<Child> keys;
+  const auto startKeys = [&] {
+    spawn(keys, {"jack_midiseq", "hamiltone-keys", "48000", "0", "48", "24000"}, "keys");
+    for (int i = 0; i < 100 && ports().value_or("").find("hamiltone-keys:out") == std::string::npos;
+         ++i)
+      std::this_thread::sleep_for(100ms);
+  };
+  startKeys();
+  ASSERT_NE(ports().value_or("").find("hamiltone-keys:out"), std::string::npos);
+  spawn(player_, {HAMILTONE_PLAY, "--api", "jack", "--quiet", "--preset", paper}, "player");
+  EXPECT_TRUE(playerSays("MIDI input ports: 0: hamiltone-keys:out; choose one with --midi-port N"));
+  player_->signal(SIGINT);
+  EXPECT_EQ(player_->wait(30.0), 0) << slurp(dir_ / "player.err");
+
+  spawn(player_,
+        {HAMILTONE_PLAY, "--api", "jack", "--quiet", "--preset", paper, "--midi-port", "0"},
+        "player");
+  for (int i = 0;
+       i < 100 && ports().value_or("").find("hamiltone:hamiltone-in") == std::string::npos; ++i)
+    std::this_thread::sleep_for(100ms);
+  keys.reset();  // SIGTERM: the keyboard is gone
+  EXPECT_TRUE(
+      playerSays("warning: the MIDI input port \"hamiltone-keys:out\" is gone, so no MIDI "
+                 "input is connected"));
+  startKeys();
+  EXPECT_TRUE(playerSays("the MIDI input port \"hamiltone-keys:out\" is back: connected"));
+  EXPECT_FALSE(player_->wait(0.1)) << slurp(dir_ / "player.err");
+  player_->signal(SIGINT);
+  EXPECT_EQ(player_->wait(30.0), 0) << slurp(dir_ / "player.err");
+  EXPECT_EQ(slurp(dir_ / "player.err").find("no MIDI input is connected, so"), std::string::npos);
+}
+
+// A budget no callback can keep (--cpu-limit 0.001 %) drops the voice limit while the six-key
+// chord sounds, deterministically; the player says so, with the load, the budget, the new limit
+// and what to change — and stops at the floor of 4 keys, not 1.
+TEST_F(JackPlay, SaysWhyTheVoiceLimitDropped) {
+  if (!onPath("jackd") || !onPath("jack_lsp"))
+    GTEST_SKIP() << "jackd (Debian's jackd2) is not installed";
+  ASSERT_NO_FATAL_FAILURE(startServer(false));
+  const std::optional<int> code =
+      playToTheEnd({"--preset", HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml", "--notes",
+                    "C4:100:0.5, E4:100:0.5, G4:100:0.5, C5:100:0.5, E5:100:0.5, G5:100:0.5",
+                    "--cpu-limit", "0.001", "--threads", "1"});
+  const std::string err = slurp(dir_ / "player.err");
+  EXPECT_EQ(code, 0) << err;
+  std::smatch line;
+  ASSERT_TRUE(std::regex_search(
+      err, line,
+      std::regex("hamiltone-play: voice limit lowered( \\([0-9]+ times\\))? to ([0-9]+) of "
+                 "[0-9]+: the audio callback took [0-9]+% of its 5\\.3 ms period \\(256 frames at "
+                 "48000 Hz\\), over the 0\\.001% budget; to keep more voices use a larger buffer "
+                 "\\(the JACK server's period, jackd -p 512\\)")))
+      << err;
+  EXPECT_GE(std::stoi(line[2]), 4) << err;
+  EXPECT_LE(std::stoi(line[2]), 5) << err;
 }
 
 }  // namespace

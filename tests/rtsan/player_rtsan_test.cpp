@@ -3,7 +3,8 @@
 // syscall made inside it — by the player, the synthesizer, a voice or the C++ library — ends the
 // process with a report and a nonzero exit. The synthesizer's workers render keys in the same
 // real-time context (WorkerPool::drain is nonblocking too), so their path is checked as well.
-// It plays the test performance at 44.1, 48 and 96 kHz in blocks of 1, 64, 256 and 1024 frames,
+// It plays the test performance at 44.1, 48 and 96 kHz in blocks of 1, 64, 256 and 1024 frames
+// (from the MIDI queue and, at once, as a score, as --midi and --notes play it),
 // on the callback's thread alone and on 3 threads; then, on 3 threads, a chord of six keys under
 // the pedal, struck again and again, so that every block shares several keys with the workers.
 // It fails too on any sample that is not finite, is subnormal or is outside [−1, 1]. Without
@@ -60,6 +61,7 @@ int main() {
         SpscQueue<app::StampedMessage> midi(256);
         SpscQueue<float> record(2 * static_cast<size_t>(rate));
         app::Player player(synth, midi, &record, rate, frames);
+        player.setScore(testing::kPerformance);  // the score's path too, merged with the queue's
         std::vector<float> interleaved(2 * static_cast<size_t>(frames)), drained(2 * 1024);
         testing::SampleFaults faults;
         long recorded = 0;

@@ -221,7 +221,8 @@ TEST(NoAllocation, SynthProcess) {
   EXPECT_EQ(synth.guardEvents(), 0);
 }
 
-// The audio callback's work (app/player.cpp): the MIDI queue drained onto sample offsets, the
+// The audio callback's work (app/player.cpp): the MIDI queue drained onto sample offsets and
+// merged with a score's (the same performance, as --midi or --notes would give it), the
 // synthesizer, the recording tee and the load measurement, over the rate × block-size grid.
 TEST(NoAllocation, PlayerRender) {
   for (double rate : {44100.0, 48000.0, 96000.0}) {
@@ -234,6 +235,7 @@ TEST(NoAllocation, PlayerRender) {
       SpscQueue<app::StampedMessage> midi(256);
       SpscQueue<float> record(2 * static_cast<size_t>(rate));
       app::Player player(synth, midi, &record, rate, frames);
+      player.setScore(testing::kPerformance);
       std::vector<float> interleaved(2 * static_cast<size_t>(frames)), drained(2 * 1024);
       const long before = forbiddenNews;
       forbidAllocation(true);
