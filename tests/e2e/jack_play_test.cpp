@@ -39,6 +39,7 @@
 extern char** environ;
 
 #include "support/child_process.h"
+#include "support/jack_log.h"
 #include "support/midi_writer.h"
 #include "support/recording.h"
 #include "support/sent_score.h"
@@ -59,6 +60,7 @@ using hamiltone::testing::onset;
 using hamiltone::testing::parseLog;
 using hamiltone::testing::readMono;
 using hamiltone::testing::slurp;
+using hamiltone::testing::xrunReports;
 
 constexpr double kRate = 48000.0;
 constexpr int kPeriod = 256;  // the server's buffer; JACK MIDI moves messages once per period
@@ -74,16 +76,6 @@ bool realtimeAllowed() {
   });
   probe.join();
   return allowed;
-}
-
-// The xrun reports in the server's log: its own timer firing late ("JackTimedDriver::Process
-// XRun"), or a client that had not finished its cycle ("JackEngine::XRun: client = …").
-long xrunReports(const std::string& jackdLog) {
-  long reports = 0;
-  std::istringstream lines(jackdLog);
-  for (std::string line; std::getline(lines, line);)
-    if (line.find("XRun") != std::string::npos) ++reports;
-  return reports;
 }
 
 double cents(double measured, double reference) { return 1200.0 * std::log2(measured / reference); }

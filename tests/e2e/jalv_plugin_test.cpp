@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "support/child_process.h"
+#include "support/jack_log.h"
 #include "support/recording.h"
 #include "support/sent_score.h"
 #include "support/spectrum.h"
@@ -47,17 +48,26 @@ class JalvPlugin : public ::testing::Test {
     dir_ = fs::temp_directory_path() / server_;
     fs::remove_all(dir_);
     fs::create_directories(dir_);
-    for (char** v = environ; *v; ++v) env_.push_back(*v);
-    env_.push_back("JACK_DEFAULT_SERVER=" + server_);
-    env_.push_back("JACK_NO_START_SERVER=1");
-    env_.push_back("LV2_PATH=" + fs::path(HAMILTONE_LV2_BUNDLE).parent_path().string());
   }
   void TearDown() override {
+    stopAll();
+    fs::remove_all(dir_);
+  }
+
+  void stopAll() {
     sender_.reset();
     recorder_.reset();
     jalv_.reset();
     jackd_.reset();
-    fs::remove_all(dir_);
+  }
+
+  // The environment of every process of a run: on the server `server`, never started by a client.
+  void useServer(const std::string& server) {
+    env_.clear();
+    for (char** v = environ; *v; ++v) env_.push_back(*v);
+    env_.push_back("JACK_DEFAULT_SERVER=" + server);
+    env_.push_back("JACK_NO_START_SERVER=1");
+    env_.push_back("LV2_PATH=" + fs::path(HAMILTONE_LV2_BUNDLE).parent_path().string());
   }
 
   void spawn(std::optional<Child>& slot, const std::vector<std::string>& argv,
@@ -84,20 +94,29 @@ class JalvPlugin : public ::testing::Test {
         << slurp(dir_ / "jackd.err") << slurp(dir_ / "jalv.err");
   }
 
+  struct Take {
+    long xruns = 0;         // xrunReports() in the server's log
+    std::vector<double> x;  // the recording, mono
+    std::vector<Note> notes;
+  };
+  static constexpr int kAttempts = 3;
+  void perform(int attempt, Take& take);
+  void listen(const Take& take, bool timing);
+
   std::string missing_, server_;
   fs::path dir_;
   std::vector<std::string> env_;
   std::optional<Child> jackd_, jalv_, recorder_, sender_;
 };
 
-TEST_F(JalvPlugin, PlaysAScoreFromJackMidiInTuneAtTheServersRate) {
-  if (!missing_.empty()) {
-    if (std::getenv("CI") && std::string(std::getenv("CI")) == "true")
-      FAIL() << "missing in CI: " << missing_ << " (scripts/install-deps.sh installs them)";
-    GTEST_SKIP() << "not installed: " << missing_;
-  }
-  spawn(jackd_,
-        {"jackd", "-n", server_, "--no-realtime", "-d", "dummy", "-r", "44100", "-p", "256"},
+// One run: a server of its own (the attempt's), jalv with the plugin, the recorder, the sender's
+// score; the server's xrun reports, the recording and the sender's notes. Fatal failures for
+// anything that keeps the run from happening.
+void JalvPlugin::perform(int attempt, Take& take) {
+  stopAll();
+  const std::string server = server_ + "-" + std::to_string(attempt);
+  useServer(server);
+  spawn(jackd_, {"jackd", "-n", server, "--no-realtime", "-d", "dummy", "-r", "44100", "-p", "256"},
         "jackd");
   ASSERT_NO_FATAL_FAILURE(awaitPort("system:playback_1", jackd_, 15.0));
   // jalv's console reads commands from stdin and quits at its end: a pipe keeps it open.
@@ -120,17 +139,23 @@ TEST_F(JalvPlugin, PlaysAScoreFromJackMidiInTuneAtTheServersRate) {
   EXPECT_EQ(jalv_->wait(10.0), 0) << slurp(dir_ / "jalv.err");
   const std::string jalvOut = slurp(dir_ / "jalv.out");
   EXPECT_NE(jalvOut.find("Sample rate:  44100 Hz"), std::string::npos) << jalvOut;
+  take.xruns = xrunReports(slurp(dir_ / "jackd.err"));
 
   SF_INFO info;
-  const std::vector<double> x = readMono(wav, info);
+  take.x = readMono(wav, info);
   ASSERT_EQ(info.samplerate, 44100);
   ASSERT_GE(info.frames, 10 * 44100);
-  const std::vector<Note> notes = notesOf(parseLog(slurp(dir_ / "sender.out")));
-  ASSERT_EQ(notes.size(), 5u);
-  // The first sound is the first note; the others are placed from it by the sender's log, within
-  // JACK MIDI's period (a message moves at the start of the sender's next cycle) and the onset
-  // detector's millisecond. Each is measured from 0.2 s after its strike until its damper falls,
-  // as in tests/e2e/jack_play_test.cpp: in tune is within 3 cents.
+  take.notes = notesOf(parseLog(slurp(dir_ / "sender.out")));
+  ASSERT_EQ(take.notes.size(), 5u);
+}
+
+// The first sound is the first note; the others are placed from it by the sender's log, within
+// JACK MIDI's period (a message moves at the start of the sender's next cycle) and the onset
+// detector's millisecond — judged only when `timing`. Each is measured from 0.2 s after its strike
+// until its damper falls, as in tests/e2e/jack_play_test.cpp: in tune is within 3 cents.
+void JalvPlugin::listen(const Take& take, bool timing) {
+  const std::vector<double>& x = take.x;
+  const std::vector<Note>& notes = take.notes;
   const auto loud = std::find_if(x.begin(), x.end(), [](double v) { return std::abs(v) > 0.01; });
   ASSERT_NE(loud, x.end()) << "the recording is silent";
   const long first = loud - x.begin();
@@ -140,7 +165,9 @@ TEST_F(JalvPlugin, PlaysAScoreFromJackMidiInTuneAtTheServersRate) {
     const long at = onset(e, expected - 2205, expected + 4410);
     ASSERT_GE(at, 0);
     ASSERT_GT(e[at], 0.001) << "note " << n.key << " is not in the recording";
-    EXPECT_NEAR((at - expected) / kRate, 0.0, 256 / kRate + 1e-3) << "note " << n.key;
+    if (timing) {
+      EXPECT_NEAR((at - expected) / kRate, 0.0, 256 / kRate + 1e-3) << "note " << n.key;
+    }
     const long from = at + std::lround(0.2 * kRate);
     const long to = at + std::lround((n.damped - n.on - 0.01) * kRate);
     ASSERT_LT(from + 22050, to) << "note " << n.key;
@@ -152,6 +179,26 @@ TEST_F(JalvPlugin, PlaysAScoreFromJackMidiInTuneAtTheServersRate) {
     std::printf("note %d: onset %+.2f ms from the log, pitch %+.3f cents\n", n.key,
                 1e3 * (at - expected) / kRate, cents);
   }
+}
+
+// On a busy host the dummy driver's graph has xruns of its own (see JackPlay's test), and a run
+// with one cannot place notes in time: such a run is played again, up to kAttempts times, and
+// onset timing is judged on the first clean run; pitch and presence on every run.
+TEST_F(JalvPlugin, PlaysAScoreFromJackMidiInTuneAtTheServersRate) {
+  if (!missing_.empty()) {
+    if (std::getenv("CI") && std::string(std::getenv("CI")) == "true")
+      FAIL() << "missing in CI: " << missing_ << " (scripts/install-deps.sh installs them)";
+    GTEST_SKIP() << "not installed: " << missing_;
+  }
+  for (int attempt = 1; attempt <= kAttempts; ++attempt) {
+    Take take;
+    ASSERT_NO_FATAL_FAILURE(perform(attempt, take));
+    std::printf("run %d: %ld xrun reports in the server's log\n", attempt, take.xruns);
+    ASSERT_NO_FATAL_FAILURE(listen(take, take.xruns == 0));
+    if (take.xruns == 0 || HasFailure()) return;
+  }
+  GTEST_SKIP() << "the JACK server logged xruns in all " << kAttempts
+               << " runs (a busy host): onset timing was not judged";
 }
 
 }  // namespace
