@@ -1,4 +1,4 @@
-// Strict number parsing for hamiltone-sim: "1e-3" yes; "1e-3x", "", "nan", "inf" no.
+// Strict number parsing for the command-line programs: "1e-3" yes; "1e-3x", "", "nan", "inf" no.
 #include "number_arguments.h"
 
 #include <cerrno>
