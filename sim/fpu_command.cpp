@@ -8,9 +8,9 @@
 
 #include "atomic_file.h"
 #include "csv_run.h"
-#include "models/fpu.h"
-#include "models/slow_fast_fpu.h"
 #include "number_arguments.h"
+#include "problems/fpu.h"
+#include "problems/slow_fast_fpu.h"
 #include "schemes/asynchronous_marazzato.h"
 #include "schemes/marazzato.h"
 #include "schemes/sav.h"

@@ -8,8 +8,8 @@
 
 #include "atomic_file.h"
 #include "csv_run.h"
-#include "models/particle.h"
 #include "number_arguments.h"
+#include "problems/particle.h"
 #include "schemes/marazzato.h"
 
 namespace hamiltone::cli {

@@ -11,9 +11,9 @@
 
 #include "atomic_file.h"
 #include "csv_run.h"
-#include "models/linearly_implicit_plate.h"
-#include "models/plate.h"
+#include "instruments/plate.h"
 #include "number_arguments.h"
+#include "schemes/reference/linearly_implicit_plate.h"
 #include "schemes/sav.h"
 #include "schemes/stormer_verlet.h"
 #include "snapshots.h"

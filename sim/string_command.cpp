@@ -12,10 +12,10 @@
 
 #include "atomic_file.h"
 #include "csv_run.h"
-#include "models/discrete_gradient_string.h"
-#include "models/hammer.h"
-#include "models/string.h"
+#include "instruments/hammer.h"
+#include "instruments/string.h"
 #include "number_arguments.h"
+#include "schemes/reference/discrete_gradient_string.h"
 #include "schemes/sav.h"
 #include "schemes/stormer_verlet.h"
 #include "snapshots.h"

@@ -14,8 +14,8 @@
 
 #include "atomic_file.h"
 #include "csv_run.h"
-#include "models/nonlinear_wave.h"
 #include "number_arguments.h"
+#include "problems/nonlinear_wave.h"
 #include "schemes/variable_step_marazzato.h"
 #include "snapshots.h"
 #include "usage_error.h"

@@ -9,8 +9,8 @@
 
 #include "atomic_file.h"
 #include "csv_run.h"
-#include "models/inhomogeneous_wave.h"
 #include "number_arguments.h"
+#include "problems/inhomogeneous_wave.h"
 #include "schemes/asynchronous_marazzato.h"
 #include "schemes/marazzato.h"
 #include "usage_error.h"

@@ -369,7 +369,7 @@ TEST_F(SimCli, ParticleWritesTheDocumentedCsv) {
     ASSERT_EQ(row.size(), 8u);
     EXPECT_NEAR(row[3], std::pow(std::sin(M_PI / 2 + row[0]), 4) + 1.0, 1e-14);  // sin⁴t + 1
     EXPECT_EQ(row[4], row[1] - row[3]);
-    // Second order at k = 0.01: the max error is 2.1e-4 (tests/models/particle_test.cpp).
+    // Second order at k = 0.01: the max error is 2.1e-4 (tests/problems/particle_test.cpp).
     EXPECT_LT(std::abs(row[4]), 5e-4) << "t = " << row[0];
     // (13) is H(0) = 0 up to the quadrature error, O(k²) = 1e-4 ([M Remark 2]); measured 2.4e-9.
     EXPECT_LT(std::abs(row[5]), 1e-4) << "t = " << row[0];

@@ -1,5 +1,5 @@
 // The FPU chain's split potential (53) and its gradient, on 0-based storage x[j] = q_{j+1}.
-#include "models/fpu.h"
+#include "problems/fpu.h"
 
 #include <cmath>
 #include <stdexcept>

@@ -1,6 +1,6 @@
 // Anchor keys of docs/instrument-data.md §1.1 (RT-425 "wrapped" plan; C8 from the
 // "unwrapped" plan, §1.3) and E2/F2 either side of the bass-bridge break (§1.2).
-#include "presets/piano_scale.h"
+#include "instruments/piano_scale.h"
 
 #include <algorithm>
 #include <array>

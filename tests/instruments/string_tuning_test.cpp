@@ -1,10 +1,10 @@
 // Pitch: the simulated partials are the closed-form ones, the tuning puts every key on pitch, the
 // stiff string is inharmonic as theory says, and the pitch rises with amplitude (BDZ Fig. 4–5).
-#include "models/string_tuning.h"
+#include "instruments/string_tuning.h"
 
 #include <gtest/gtest.h>
 
-#include "presets/piano_scale.h"
+#include "instruments/piano_scale.h"
 #include "schemes/sav.h"
 #include "schemes/stormer_verlet.h"
 #include "support/energy_checks.h"

@@ -1,6 +1,6 @@
 // The FPU chain: the split (53) adds up to (52), its gradient is the derivative of its potential,
 // and its stiffness matrix has the spectrum that gives the bound (54).
-#include "models/fpu.h"
+#include "problems/fpu.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // The implicit reference (67)–(68): conserves its energy, converges Newton within the paper's
 // budget, and agrees with the explicit split scheme (38) as k → 0.
-#include "models/discrete_gradient_string.h"
+#include "schemes/reference/discrete_gradient_string.h"
 
 #include <gtest/gtest.h>
 
@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "models/string.h"
+#include "instruments/string.h"
 #include "schemes/sav.h"
 #include "support/energy_checks.h"
 #include "util/format_number.h"

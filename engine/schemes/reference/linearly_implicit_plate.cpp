@@ -1,5 +1,5 @@
 // The plate's linearly implicit scheme (83): ℓ(q^n, ·) as a matrix, the SPD solve for F^{n+1}.
-#include "models/linearly_implicit_plate.h"
+#include "schemes/reference/linearly_implicit_plate.h"
 
 #include <stdexcept>
 #include <string>

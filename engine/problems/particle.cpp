@@ -1,5 +1,5 @@
 // The [M §3.1] particle's potential, its force and its exact solution.
-#include "models/particle.h"
+#include "problems/particle.h"
 
 #include <cmath>
 

@@ -1,5 +1,5 @@
 // The felt law, the contact distribution J and the hammer's part of the potential and gradient.
-#include "models/hammer.h"
+#include "instruments/hammer.h"
 
 #include <algorithm>
 #include <cmath>

@@ -5,7 +5,7 @@
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
 
-#include "models/string.h"
+#include "instruments/string.h"
 #include "schemes/hamiltonian.h"
 
 namespace hamiltone {

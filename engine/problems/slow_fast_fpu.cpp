@@ -1,5 +1,5 @@
 // The slow/fast FPU chain's three potentials V_F, V_M, V_S and their gradients, [M §4.3.1].
-#include "models/slow_fast_fpu.h"
+#include "problems/slow_fast_fpu.h"
 
 #include <cmath>
 #include <numbers>

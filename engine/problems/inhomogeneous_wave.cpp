@@ -1,5 +1,5 @@
 // The inhomogeneous wave's springs, partition, initial data and exact solution, [M §4.3.2].
-#include "models/inhomogeneous_wave.h"
+#include "problems/inhomogeneous_wave.h"
 
 #include <cmath>
 #include <stdexcept>

@@ -1,6 +1,6 @@
 // The [M §3.1] particle: sin⁴t + 1 solves its equation of motion, its force is the derivative of
 // its potential, and Marazzato's scheme converges to it at second order with each quadrature.
-#include "models/particle.h"
+#include "problems/particle.h"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
 // The [M §3.3] nonlinear wave: its force is the derivative of its potential, its consistent mass
 // is inverted and really used, and Marazzato's scheme over it reproduces Table 1, Fig. 6 and the
 // adaptive step of Remark 8.
-#include "models/nonlinear_wave.h"
+#include "problems/nonlinear_wave.h"
 
 #include <gtest/gtest.h>
 

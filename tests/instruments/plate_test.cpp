@@ -1,7 +1,7 @@
 // The von Kármán plate: the Airy solve is exact, ∇V' = −h² ℓ(q, F) is the derivative of V' (so
 // the misprint in (78) is corrected), (38) conserves (41) through turbulence, the linear modes
 // are the closed-form ones, and large amplitude shortens the period (BDZ §4.3).
-#include "models/plate.h"
+#include "instruments/plate.h"
 
 #include <gtest/gtest.h>
 

@@ -2,7 +2,7 @@
 // density and tension, from Chabassier & Duruflé's Steinway D model (RT-425).
 #pragma once
 
-#include "models/string.h"
+#include "instruments/string.h"
 
 namespace hamiltone {
 

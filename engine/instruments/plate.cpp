@@ -1,12 +1,12 @@
 // The plate's stencils (DΔ, ℓ of (78)), the exact Airy solve by dense 2-D DST-I, and V', ∇V' (81).
-#include "models/plate.h"
+#include "instruments/plate.h"
 
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
 #include <string>
 
-#include "models/grid.h"
+#include "instruments/grid.h"
 #include "util/format_number.h"
 
 namespace hamiltone {

@@ -2,7 +2,7 @@
 // the closed-form spectrum the tuning and the bound (44) rely on, the loss operator is −ρA h D2 on
 // each grid, one coarse cell is the Kirchhoff–Carrier string, the grid rules size the grids as
 // documented, and unphysical strings are refused.
-#include "models/string.h"
+#include "instruments/string.h"
 
 #include <gtest/gtest.h>
 
@@ -12,8 +12,8 @@
 #include <numbers>
 #include <random>
 
-#include "models/string_tuning.h"
-#include "presets/piano_scale.h"
+#include "instruments/piano_scale.h"
+#include "instruments/string_tuning.h"
 #include "schemes/sav.h"
 #include "support/energy_checks.h"
 

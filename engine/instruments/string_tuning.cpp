@@ -1,5 +1,5 @@
 // Bisection on the closed-form fundamental, alternated with the grid rule until both agree.
-#include "models/string_tuning.h"
+#include "instruments/string_tuning.h"
 
 #include <cmath>
 #include <numbers>

@@ -1,6 +1,6 @@
 // The felt hammer: its force is the derivative of its potential, J is a unit-sum spread centred
 // on the strike point, and on a rigid barrier the SAV scheme reproduces the closed-form contact.
-#include "models/hammer.h"
+#include "instruments/hammer.h"
 
 #include <gtest/gtest.h>
 

@@ -5,7 +5,7 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 
-#include "models/plate.h"
+#include "instruments/plate.h"
 #include "schemes/hamiltonian.h"
 #include "schemes/step_parameters.h"
 

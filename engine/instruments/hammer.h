@@ -7,7 +7,7 @@
 
 #include <vector>
 
-#include "models/string.h"
+#include "instruments/string.h"
 #include "schemes/hamiltonian.h"
 
 namespace hamiltone {

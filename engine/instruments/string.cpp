@@ -1,5 +1,5 @@
 // The string's stiffness stencils and its split potential (65) with the gradient by the chain rule.
-#include "models/string.h"
+#include "instruments/string.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "models/grid.h"
+#include "instruments/grid.h"
 #include "util/format_number.h"
 
 namespace hamiltone {

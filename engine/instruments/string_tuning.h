@@ -2,7 +2,7 @@
 // and the tension (or length) that puts the simulated fundamental on a target pitch.
 #pragma once
 
-#include "models/string.h"
+#include "instruments/string.h"
 
 namespace hamiltone {
 

@@ -1,5 +1,5 @@
 // The [M §3.3] string's potential, force and consistent-mass solve.
-#include "models/nonlinear_wave.h"
+#include "problems/nonlinear_wave.h"
 
 #include <algorithm>
 #include <cmath>

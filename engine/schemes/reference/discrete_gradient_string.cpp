@@ -1,5 +1,5 @@
 // The string's discrete-gradient scheme (67)–(68): residual, banded Jacobian, Newton–Raphson.
-#include "models/discrete_gradient_string.h"
+#include "schemes/reference/discrete_gradient_string.h"
 
 #include <algorithm>
 #include <cmath>

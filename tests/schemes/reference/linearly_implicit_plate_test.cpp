@@ -1,6 +1,6 @@
 // The plate's linearly implicit reference (83): its matrix is the bracket (78), it conserves the
 // energy derived in its header, it agrees with the split scheme (38) as k → 0, and it is lossless.
-#include "models/linearly_implicit_plate.h"
+#include "schemes/reference/linearly_implicit_plate.h"
 
 #include <gtest/gtest.h>
 
