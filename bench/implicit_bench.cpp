@@ -8,11 +8,11 @@
 #include <numbers>
 #include <string>
 
-#include "models/discrete_gradient_string.h"
-#include "models/linearly_implicit_plate.h"
-#include "models/plate.h"
-#include "models/string.h"
+#include "instruments/plate.h"
+#include "instruments/string.h"
 #include "recording_reporter.h"
+#include "schemes/reference/discrete_gradient_string.h"
+#include "schemes/reference/linearly_implicit_plate.h"
 #include "schemes/sav.h"
 #include "schemes/stormer_verlet.h"
 

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "models/plate.h"
+#include "instruments/plate.h"
 #include "recording_reporter.h"
 #include "schemes/sav.h"
 #include "schemes/stormer_verlet.h"

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "models/fpu.h"
+#include "problems/fpu.h"
 #include "recording_reporter.h"
 #include "schemes/marazzato.h"
 #include "schemes/sav.h"

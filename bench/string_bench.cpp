@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "models/string.h"
-#include "presets/piano_scale.h"
+#include "instruments/piano_scale.h"
+#include "instruments/string.h"
 #include "recording_reporter.h"
 #include "schemes/sav.h"
 #include "schemes/stormer_verlet.h"

@@ -24,7 +24,7 @@
 #include <string_view>
 #include <vector>
 
-#include "models/string_tuning.h"
+#include "instruments/string_tuning.h"
 #include "presets/preset_loader.h"
 #include "synth/denormals.h"
 #include "synth/instrument.h"

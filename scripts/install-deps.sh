@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev       # engine: vectors and the scheme state
-  libcli11-dev        # render/: hamiltone-sim's and hamiltone-render's command lines
+  libcli11-dev        # cli/, render/, sim/: hamiltone-render's and hamiltone-sim's command lines
   libtomlplusplus-dev # engine/presets: the TOML preset files
   libsndfile1-dev     # render/: hamiltone-render's WAV output
   # app/: hamiltone-play's audio output and MIDI input. They need a JACK development package,

@@ -49,7 +49,7 @@ elif ! "$python" -c 'import matplotlib, numpy' 2>/dev/null; then
   exit 77
 fi
 
-sim="$build_dir/render/hamiltone-sim"
+sim="$build_dir/sim/hamiltone-sim"
 render="$build_dir/render/hamiltone-render"
 # Optional: a tree built without the benchmarks lacks it, and its section says so.
 grids="$build_dir/bench/hamiltone_validate_grids"

@@ -4,7 +4,7 @@ u(L/2) over 20 ms on each grid rule and oversampling against a 128x longitudinal
 Usage: python3 docs/scripts/string_grid_tradeoff.py [path/to/hamiltone-sim]  (run in a scratch dir)"""
 import sys
 import subprocess, math, csv, time
-SIM = sys.argv[1] if len(sys.argv) > 1 else "build/release/render/hamiltone-sim"
+SIM = sys.argv[1] if len(sys.argv) > 1 else "build/release/sim/hamiltone-sim"
 L, c_L = 1.259, math.sqrt(2.02e11/7850)
 def segs_long(k): return int(L / (c_L*k))
 def run(tag, k, segments, every, v, dur=0.02):

@@ -40,7 +40,7 @@ class Context:
         out = []
         for a in map(str, args):
             if a == self.sim:
-                a = "build/release/render/hamiltone-sim"
+                a = "build/release/sim/hamiltone-sim"
             elif a == self.render:
                 a = "build/release/render/hamiltone-render"
             elif a == self.grids:

@@ -1,7 +1,7 @@
 // Reading a preset: the TOML syntax (toml++), every key against the parameter table (name, type,
-// range, model, per key), the command line's --set over the file's keys, the bounds one parameter
-// sets another, the per-key values between the [[key]] anchors, the Instrument itself, and the
-// voices' own checks at a few keys.
+// range, model, per key), the command line's --set over the file's keys and the bounds one
+// parameter sets another; then the model's builder (string_builder.h, plate_builder.h) makes the
+// Instrument and checks its voices at a few keys, whose complaints are pointed at the settings.
 #include "presets/preset_loader.h"
 
 #include <toml++/toml.h>
@@ -11,15 +11,14 @@
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
-#include <map>
-#include <numbers>
 #include <optional>
 #include <set>
 
 #include "presets/parameters.h"
+#include "presets/plate_builder.h"
+#include "presets/preset_values.h"
+#include "presets/string_builder.h"
 #include "util/format_number.h"
-#include "voices/plate_voice.h"
-#include "voices/string_voice.h"
 
 namespace hamiltone {
 
@@ -32,38 +31,12 @@ constexpr size_t kMaxKept = 1000;     // errors kept for sorting; beyond, only c
 constexpr size_t kMaxSuggested = 64;  // longer names get no "did you mean"
 constexpr size_t kMaxShown = 40;      // bytes of a name or text value quoted in a message
 constexpr size_t kMaxText = 200;      // bytes of a text parameter
-constexpr double kCheckRate = 48000.0;
-
-// In the file, or the nth --set (n >= 1): those come after the file, in the order given.
-struct Place {
-  int set = 0;
-  long line = 1, column = 1;
-  auto operator<=>(const Place&) const = default;
-};
 
 Place placeOf(const toml::source_region& region) {
   if (region.begin.line == 0) return {};
   return {.line = static_cast<long>(region.begin.line),
           .column = static_cast<long>(region.begin.column)};
 }
-
-// A value the file sets: a number (real, integer, note; a boolean as 1 or 0) or a word, where it
-// stands, and how a message shows it.
-struct Setting {
-  double number = 0.0;
-  std::string word = {};
-  Place place;
-  std::string shown;
-};
-
-using Settings = std::map<std::string_view, Setting>;  // by the table's name of the parameter
-
-struct Anchor {
-  int note = 0;
-  Place place;        // of its note = …
-  std::string shown;  // the note as written
-  Settings values;
-};
 
 // Where a value came from, and how an error line names it: "key[C3].string.tension_N = 759".
 struct Blame {
@@ -99,6 +72,14 @@ std::string approximate(double x) { return formatApprox(x, 6); }
 
 std::string_view modelName(InstrumentModel m) {
   return m == InstrumentModel::string ? "string" : "plate";
+}
+
+// "plate model only; this preset's model is \"string\"": a key or table of the other model.
+std::string otherModelOnly(InstrumentModel model) {
+  const InstrumentModel other =
+      model == InstrumentModel::string ? InstrumentModel::plate : InstrumentModel::string;
+  return std::string(modelName(other)) + " model only; this preset's model is \"" +
+         std::string(modelName(model)) + "\"";
 }
 
 bool inChoices(std::string_view choices, std::string_view word) {
@@ -299,68 +280,6 @@ std::vector<std::string_view> keyNames(bool perKeyOnly) {
   return out;
 }
 
-// A voice's complaint ("damper_t60_s = 0.001: must be …") names its field; this is the preset
-// parameter it comes from. `keep`: the voice's own "field = value" says more than the parameter's
-// value would (a derived quantity), so the whole message is kept.
-struct VoiceField {
-  std::string_view field, parameter;
-  bool keep = false;
-};
-
-constexpr VoiceField kStringFields[] = {
-    {"oversampling", "scheme.oversampling"},
-    {"a4_hz", "a4_Hz"},
-    {"damper_t60_s", "loss.damper_t60_s"},
-    {"pickup_position", "pickups.left_position"},
-    {"channels", "pickups.channels"},
-    {"gain", "pickups.gain"},
-    {"hammer_velocity_max_m_s", "hammer.velocity_max_m_s"},
-    {"velocity_curve", "hammer.velocity_curve"},
-    {"guard_energy_multiple", "scheme.guard_energy_multiple"},
-    {"epsilon_j", "scheme.epsilon_J"},
-    {"tension_margin", "scheme.tension_margin"},
-    {"bend_range_semitones", "bend_range_semitones"},
-    {"tension scale range", "bend_range_semitones", true},
-    {"t60_low_s", "loss.t60_low_s"},
-    {"t60_high_s", "loss.t60_high_s"},
-    {"t60_high_hz", "loss.t60_high_Hz"},
-    {"tension", "string.tension_N"},
-    {"length", "string.length_m"},
-    {"young", "string.young_Pa"},
-    {"grid factor", "scheme.grid_factor"},
-    {"hammer mass", "hammer.mass_kg"},
-    {"hammer stiffness", "hammer.stiffness_N_per_m_p"},
-    {"hammer exponent", "hammer.exponent"},
-    {"hammer position", "hammer.position"},
-    {"hammer width", "hammer.width_m"},
-};
-
-constexpr VoiceField kPlateFields[] = {
-    {"oversampling", "scheme.oversampling"},
-    {"strike_position", "strike.position_x"},
-    {"strike_position_high", "strike.position_x_high"},
-    {"pickup_position", "pickups.left_x"},
-    {"strike_width_m", "strike.width_m"},
-    {"force_max_n", "strike.force_max_N"},
-    {"duration_max_s", "strike.duration_max_s"},
-    {"velocity_curve", "strike.velocity_curve"},
-    {"damper_t60_s", "loss.damper_t60_s"},
-    {"gain", "pickups.gain"},
-    {"guard_energy_multiple", "scheme.guard_energy_multiple"},
-    {"t60_low_s", "loss.t60_low_s"},
-    {"t60_high_s", "loss.t60_high_s"},
-    {"t60_high_hz", "loss.t60_high_Hz"},
-    {"grid points per side", "plate.lx_m", true},
-    {"plate side", "plate.lx_m", true},
-    {"grid factor", "scheme.grid_factor"},
-    {"young", "plate.young_Pa"},
-    {"density", "plate.density_kg_m3"},
-    {"thickness", "plate.thickness_m"},
-    {"lx", "plate.lx_m"},
-    {"ly", "plate.ly_m"},
-    {"poisson", "plate.poisson"},
-};
-
 class Loader {
  public:
   explicit Loader(std::string source) : source_(std::move(source)) {}
@@ -393,22 +312,14 @@ class Loader {
   void voiceError(std::string_view message, int note);
   std::string withOverrides(Place blamed) const;
 
-  const Parameter& row(std::string_view name) const;
-  const Setting* setting(std::string_view name) const;
-  double number(std::string_view name) const;
-  std::string word(std::string_view name) const;
-  bool anchored(const Parameter& p) const;
-  double atKey(const Parameter& p, int note) const;
   Blame blame(const Parameter& p, int note, bool sayNote) const;
 
   std::string source_;
   std::vector<std::pair<Place, std::string>> errors_;
   size_t dropped_ = 0;
-  std::optional<InstrumentModel> model_;
-  Settings settings_;
+  PresetValues values_;
   std::set<std::string> seen_;          // names the file sets, valid or not
   std::set<std::string_view> invalid_;  // parameters set somewhere to an invalid value
-  std::vector<Anchor> anchors_;         // by note once read
   std::set<std::pair<Place, std::string_view>> voiceReported_;  // (setting, parameter)
   std::vector<std::string> overrides_;  // "--set NAME=VALUE" for each, as messages show it
 };
@@ -474,8 +385,8 @@ Instrument Loader::load(std::string_view text, const PresetOptions& options) {
 // other keys.
 void Loader::readModel(const toml::table& root) {
   if (const toml::node* model = root.get("model"); model && model->is_string()) {
-    if (model->as_string()->get() == "string") model_ = InstrumentModel::string;
-    if (model->as_string()->get() == "plate") model_ = InstrumentModel::plate;
+    if (model->as_string()->get() == "string") values_.model = InstrumentModel::string;
+    if (model->as_string()->get() == "plate") values_.model = InstrumentModel::plate;
   }
 }
 
@@ -486,7 +397,7 @@ void Loader::readRoot(const toml::table& root) {
     if (name == "key")
       readAnchors(value, at);
     else if (!isSection(name))
-      entry(name, value, at, settings_, "");
+      entry(name, value, at, values_.settings, "");
     else if (const toml::table* table = value.as_table())
       readSection(name, *table, at);
     else
@@ -495,28 +406,23 @@ void Loader::readRoot(const toml::table& root) {
 }
 
 void Loader::readSection(std::string_view section, const toml::table& table, Place at) {
-  if (model_) {
+  if (values_.model) {
     const auto all = parameters();
     const bool any = std::any_of(all.begin(), all.end(), [&](const Parameter& p) {
-      return sectionOf(p.name) == section && appliesTo(p, *model_);
+      return sectionOf(p.name) == section && appliesTo(p, *values_.model);
     });
     if (!any) {
-      error(
-          at,
-          "[" + std::string(section) + "]: " +
-              std::string(modelName(*model_ == InstrumentModel::string ? InstrumentModel::plate
-                                                                       : InstrumentModel::string)) +
-              " model only; this preset's model is \"" + std::string(modelName(*model_)) + "\"");
+      error(at, "[" + std::string(section) + "]: " + otherModelOnly(*values_.model));
       return;
     }
   }
   for (auto&& [key, value] : table)
     entry(std::string(section) + "." + std::string(key.str()), value, placeOf(key.source()),
-          settings_, "");
+          values_.settings, "");
 }
 
 void Loader::readAnchors(const toml::node& node, Place at) {
-  if (model_ == InstrumentModel::plate) {
+  if (values_.model == InstrumentModel::plate) {
     error(at, "[[key]]: string model only; this preset's model is \"plate\"");
     return;
   }
@@ -530,7 +436,7 @@ void Loader::readAnchors(const toml::node& node, Place at) {
                   std::to_string(kMaxAnchors));
   for (size_t i = 0; i < std::min(list->size(), kMaxAnchors); ++i)
     readAnchor(*(*list)[i].as_table(), i + 1);
-  std::stable_sort(anchors_.begin(), anchors_.end(),
+  std::stable_sort(values_.anchors.begin(), values_.anchors.end(),
                    [](const Anchor& a, const Anchor& b) { return a.note < b.note; });
 }
 
@@ -546,7 +452,7 @@ void Loader::readAnchor(const toml::table& table, size_t ordinal) {
       anchor.shown = note->shown;
       label = "key[" + noteName(anchor.note) + "]";
       valid = true;
-      for (const Anchor& other : anchors_)
+      for (const Anchor& other : values_.anchors)
         if (other.note == anchor.note) {
           error(anchor.place, label + ".note = " + anchor.shown + ": duplicate anchor; " +
                                   noteName(anchor.note) + " is already an anchor at line " +
@@ -570,7 +476,7 @@ void Loader::readAnchor(const toml::table& table, size_t ordinal) {
       entry(name, value, at, anchor.values, label);
     }
   }
-  if (valid) anchors_.push_back(std::move(anchor));
+  if (valid) values_.anchors.push_back(std::move(anchor));
 }
 
 // Each --set after the file, as a key of the file: a valid one replaces the file's value, and a
@@ -589,8 +495,8 @@ void Loader::readOverrides(const std::vector<PresetOverride>& overrides) {
     Settings valid;
     entry(o.name, *value.get("x"), at, valid, "");
     for (auto& [name, setting] : valid) {
-      settings_[name] = std::move(setting);
-      for (Anchor& a : anchors_) a.values.erase(name);
+      values_.settings[name] = std::move(setting);
+      for (Anchor& a : values_.anchors) a.values.erase(name);
     }
   }
 }
@@ -616,13 +522,9 @@ void Loader::entry(std::string name, const toml::node& value, Place at, Settings
     return;
   }
   seen_.insert(name);
-  const Parameter* p = model_ ? findParameter(name, *model_) : any;
+  const Parameter* p = values_.model ? findParameter(name, *values_.model) : any;
   if (!p) {
-    error(at,
-          head + ": " +
-              std::string(modelName(*model_ == InstrumentModel::string ? InstrumentModel::plate
-                                                                       : InstrumentModel::string)) +
-              " model only; this preset's model is \"" + std::string(modelName(*model_)) + "\"");
+    error(at, head + ": " + otherModelOnly(*values_.model));
     return;
   }
   if (!label.empty() && !p->perKey) {
@@ -709,7 +611,7 @@ std::optional<Setting> Loader::convert(const Parameter& p, const toml::node& val
 void Loader::checkRequired() {
   for (const Parameter& p : parameters())
     if (p.defaultKind == DefaultKind::required && sectionOf(p.name) != "key" &&
-        !seen_.count(std::string(p.name)) && (!model_ || appliesTo(p, *model_)))
+        !seen_.count(std::string(p.name)) && (!values_.model || appliesTo(p, *values_.model)))
       error({}, std::string(p.name) + ": missing; expected " +
                     (p.type == ParameterType::choice
                          ? listChoices(p.choices, true)
@@ -717,11 +619,11 @@ void Loader::checkRequired() {
 }
 
 void Loader::checkAnchors() {
-  const Setting* lowest = setting("lowest_note");
-  const Setting* highest = setting("highest_note");
+  const Setting* lowest = values_.setting("lowest_note");
+  const Setting* highest = values_.setting("highest_note");
   if (!lowest || !highest) return;
   const int lo = static_cast<int>(lowest->number), hi = static_cast<int>(highest->number);
-  for (const Anchor& a : anchors_)
+  for (const Anchor& a : values_.anchors)
     if (a.note < lo || a.note > hi)
       error(a.place, "key[" + noteName(a.note) + "].note = " + a.shown +
                          ": outside lowest_note … highest_note, " + noteName(lo) + " … " +
@@ -731,39 +633,40 @@ void Loader::checkAnchors() {
 // The bounds one parameter puts on another (highest_note >= lowest_note, t60_high_s <=
 // t60_low_s, …), where both values are valid.
 void Loader::checkBounds() {
-  if (!setting("lowest_note") || !setting("highest_note")) return;
+  if (!values_.setting("lowest_note") || !values_.setting("highest_note")) return;
   for (const Parameter& p : parameters()) {
     if (p.minOf.empty() && p.maxOf.empty()) continue;
-    if (model_ ? !appliesTo(p, *model_) : p.model != ParameterModel::both) continue;
+    if (values_.model ? !appliesTo(p, *values_.model) : p.model != ParameterModel::both) continue;
     const bool upper = !p.maxOf.empty();
-    const Parameter& other = row(upper ? p.maxOf : p.minOf);
+    const Parameter& other = values_.row(upper ? p.maxOf : p.minOf);
     if (!invalid_.count(p.name) && !invalid_.count(other.name)) checkBound(p, other, upper);
   }
 }
 
 void Loader::checkBound(const Parameter& p, const Parameter& other, bool upper) {
   // Without anchors for either, both hold at every key: one comparison says all.
-  const bool perKey = anchored(p) || anchored(other);
-  const int lo = static_cast<int>(number("lowest_note"));
-  const int hi = perKey ? static_cast<int>(number("highest_note")) : lo;
+  const bool perKey = values_.anchored(p) || values_.anchored(other);
+  const int lo = static_cast<int>(values_.number("lowest_note"));
+  const int hi = perKey ? static_cast<int>(values_.number("highest_note")) : lo;
   // The one set in the file is blamed; with both set, the bounded one — unless only the other was
   // given by --set, which is then what changed.
   auto bySet = [&](const Parameter& q) {
-    const Setting* s = setting(q.name);
+    const Setting* s = values_.setting(q.name);
     return s && s->place.set > 0;
   };
-  const bool blameP = (bySet(p) || !bySet(other)) && (setting(p.name) || anchored(p) ||
-                                                      (!setting(other.name) && !anchored(other)));
+  const bool blameP =
+      (bySet(p) || !bySet(other)) && (values_.setting(p.name) || values_.anchored(p) ||
+                                      (!values_.setting(other.name) && !values_.anchored(other)));
   // The anchors' own notes first, so that an anchor's value is reported at its note.
   std::vector<int> notes;
   if (perKey)
-    for (const Anchor& a : anchors_)
+    for (const Anchor& a : values_.anchors)
       if (a.values.count(p.name) || a.values.count(other.name)) notes.push_back(a.note);
   for (int note = lo; note <= hi; ++note) notes.push_back(note);
   std::set<Place> reported;
   for (int note : notes) {
-    const double x = perKey ? atKey(p, note) : number(p.name);
-    const double y = perKey ? atKey(other, note) : number(other.name);
+    const double x = perKey ? values_.atKey(p, note) : values_.number(p.name);
+    const double y = perKey ? values_.atKey(other, note) : values_.number(other.name);
     if (upper ? x <= y : x >= y) continue;
     const Blame b = blame(blameP ? p : other, note, false);
     if (!reported.insert(b.place).second) continue;
@@ -780,60 +683,11 @@ void Loader::checkBound(const Parameter& p, const Parameter& other, bool upper) 
   }
 }
 
-const Parameter& Loader::row(std::string_view name) const {
-  const Parameter* p = model_ ? findParameter(name, *model_) : findParameter(name);
-  if (!p) throw std::logic_error("preset loader: no parameter " + std::string(name));
-  return *p;
-}
-
-const Setting* Loader::setting(std::string_view name) const {
-  const auto it = settings_.find(name);
-  return it == settings_.end() ? nullptr : &it->second;
-}
-
-double Loader::number(std::string_view name) const {
-  if (const Setting* s = setting(name)) return s->number;
-  if (name == "plate.reference_note") return number("lowest_note");
-  return defaultNumber(row(name));
-}
-
-std::string Loader::word(std::string_view name) const {
-  if (const Setting* s = setting(name)) return s->word;
-  return std::string(row(name).defaultText);
-}
-
-bool Loader::anchored(const Parameter& p) const {
-  return std::any_of(anchors_.begin(), anchors_.end(),
-                     [&](const Anchor& a) { return a.values.count(p.name) > 0; });
-}
-
-// The value at `note`: the anchors that set the parameter define it (interpolated between them,
-// held beyond them); without any, the section's value or the default holds at every key.
-double Loader::atKey(const Parameter& p, int note) const {
-  const Anchor *below = nullptr, *above = nullptr;
-  for (const Anchor& a : anchors_) {
-    if (!a.values.count(p.name)) continue;
-    if (a.note <= note)
-      below = &a;
-    else if (!above)
-      above = &a;
-  }
-  if (!below && !above) return number(p.name);
-  if (!below) return above->values.at(p.name).number;
-  const double a = below->values.at(p.name).number;
-  if (!above || below->note == note || p.type == ParameterType::integer) return a;
-  const double b = above->values.at(p.name).number;
-  const double t = static_cast<double>(note - below->note) / (above->note - below->note);
-  if (p.min <= 0.0) return a + t * (b - a);
-  if (!std::isfinite(a) || !std::isfinite(b)) return INFINITY;
-  return a * std::pow(b / a, t);
-}
-
 // The setting behind p's value at `note`: the nearest anchor that sets it, the section's value,
 // or the default (at line 1).
 Blame Loader::blame(const Parameter& p, int note, bool sayNote) const {
   const Anchor* nearest = nullptr;
-  for (const Anchor& a : anchors_)
+  for (const Anchor& a : values_.anchors)
     if (a.values.count(p.name) &&
         (!nearest || std::abs(a.note - note) < std::abs(nearest->note - note)))
       nearest = &a;
@@ -843,12 +697,13 @@ Blame Loader::blame(const Parameter& p, int note, bool sayNote) const {
                                                   " = " + nearest->values.at(p.name).shown};
   if (nearest)
     return {nearest->values.at(p.name).place,
-            std::string(p.name) + " = " + approximate(atKey(p, note)) + at};
-  const Setting* s = setting(p.name);
-  const std::string value = s                                  ? s->shown
-                            : p.type == ParameterType::choice  ? "\"" + word(p.name) + "\""
-                            : p.type == ParameterType::boolean ? std::string(p.defaultText)
-                                                               : approximate(number(p.name));
+            std::string(p.name) + " = " + approximate(values_.atKey(p, note)) + at};
+  const Setting* s = values_.setting(p.name);
+  const std::string value = s                                 ? s->shown
+                            : p.type == ParameterType::choice ? "\"" + values_.word(p.name) + "\""
+                            : p.type == ParameterType::boolean
+                                ? std::string(p.defaultText)
+                                : approximate(values_.number(p.name));
   const Place place = s ? s->place : Place{};
   return {place, said(std::string(p.name), value, place) + (sayNote ? at : "")};
 }
@@ -856,133 +711,27 @@ Blame Loader::blame(const Parameter& p, int note, bool sayNote) const {
 Instrument Loader::build() const {
   Instrument instrument;
   instrument.source = source_;
-  instrument.name = setting("name") ? word("name") : std::filesystem::path(source_).stem().string();
-  instrument.model = *model_;
-  instrument.lowestNote = static_cast<int>(number("lowest_note"));
-  instrument.highestNote = static_cast<int>(number("highest_note"));
-  instrument.polyphony = static_cast<int>(number("polyphony"));
-  instrument.gainDb = number("gain_dB");
-  instrument.panSpread = number("pan_spread");
-  const PickupSignal signal =
-      word("pickups.signal") == "velocity" ? PickupSignal::velocity : PickupSignal::displacement;
-  if (*model_ == InstrumentModel::plate) {
-    PlatePatch& p = instrument.plate;
-    p.plate = {.young = number("plate.young_Pa"),
-               .density = number("plate.density_kg_m3"),
-               .poisson = number("plate.poisson"),
-               .thickness = number("plate.thickness_m"),
-               .lx = number("plate.lx_m"),
-               .ly = number("plate.ly_m")};
-    p.referenceNote = static_cast<int>(number("plate.reference_note"));
-    p.lowestNote = instrument.lowestNote;
-    p.highestNote = instrument.highestNote;
-    p.gridFactor = number("scheme.grid_factor");
-    p.oversampling = static_cast<int>(number("scheme.oversampling"));
-    p.t60Low = number("loss.t60_low_s");
-    p.t60High = number("loss.t60_high_s");
-    p.t60HighHz = number("loss.t60_high_Hz");
-    p.damperT60 = number("loss.damper_t60_s");
-    p.strike[0] = number("strike.position_x");
-    p.strike[1] = number("strike.position_y");
-    p.strikeWidth = number("strike.width_m");
-    p.forceMax = number("strike.force_max_N");
-    p.durationMin = number("strike.duration_min_s");
-    p.durationMax = number("strike.duration_max_s");
-    p.velocityCurve = number("strike.velocity_curve");
-    p.noteMovesStrike = number("strike.note_moves_strike") != 0.0;
-    p.strikeHigh[0] = number("strike.position_x_high");
-    p.strikeHigh[1] = number("strike.position_y_high");
-    p.pickups[0][0] = number("pickups.left_x");
-    p.pickups[0][1] = number("pickups.left_y");
-    p.pickups[1][0] = number("pickups.right_x");
-    p.pickups[1][1] = number("pickups.right_y");
-    p.signal = signal;
-    p.gain = number("pickups.gain");
-    p.guardEnergyMultiple = number("scheme.guard_energy_multiple");
-    return instrument;
-  }
-
-  instrument.bendRange = number("bend_range_semitones");
-  StringPatch common;
-  common.tuneBy = word("string.tune_by") == "tension" ? TuneBy::tension : TuneBy::length;
-  common.a4Hz = number("a4_Hz");
-  const std::string rule = word("scheme.grid_rule");
-  common.grid = rule == "two-grid"     ? GridRule::twoGrid
-                : rule == "transverse" ? GridRule::transverse
-                                       : GridRule::longitudinal;
-  common.gridFactor = number("scheme.grid_factor");
-  common.tensionMargin = number("scheme.tension_margin");
-  common.oversampling = static_cast<int>(number("scheme.oversampling"));
-  if (setting("scheme.epsilon_J")) common.epsilon = number("scheme.epsilon_J");
-  common.t60HighHz = number("loss.t60_high_Hz");
-  common.pickups[0] = number("pickups.left_position");
-  common.pickups[1] = number("pickups.right_position");
-  common.channels = static_cast<int>(number("pickups.channels"));
-  common.signal = signal;
-  common.gain = number("pickups.gain");
-  common.velocityMin = number("hammer.velocity_min_m_s");
-  common.velocityMax = number("hammer.velocity_max_m_s");
-  common.velocityCurve = number("hammer.velocity_curve");
-  common.guardEnergyMultiple = number("scheme.guard_energy_multiple");
-  common.bendRange = instrument.bendRange;
-  common.hammer.width = number("hammer.width_m");
-  common.string.young = number("string.young_Pa");
-  const bool stiff = number("string.bending_stiffness") != 0.0;
-  const Parameter& linearDensity = row("string.linear_density_kg_m");
-  const bool densityGiven = setting(linearDensity.name) || anchored(linearDensity);
-
-  for (int note = instrument.lowestNote; note <= instrument.highestNote; ++note) {
-    auto at = [&](std::string_view name) { return atKey(row(name), note); };
-    StringKey key{.patch = common};
-    StringPatch& p = key.patch;
-    const double d = at("string.diameter_m");
-    p.string.area = std::numbers::pi * d * d / 4.0;
-    p.string.density =
-        densityGiven ? at(linearDensity.name) / p.string.area : number("string.density_kg_m3");
-    p.string.length = at("string.length_m");
-    p.string.tension = at("string.tension_N");
-    p.string.inertia = stiff ? std::numbers::pi * std::pow(d, 4) / 64.0 : 0.0;
-    p.hammer.mass = at("hammer.mass_kg");
-    p.hammer.stiffness = at("hammer.stiffness_N_per_m_p");
-    p.hammer.exponent = at("hammer.exponent");
-    p.hammer.position = at("hammer.position");
-    p.t60Low = at("loss.t60_low_s");
-    p.t60High = at("loss.t60_high_s");
-    p.damperT60 = at("loss.damper_t60_s");
-    key.unisons = static_cast<int>(at("string.unisons"));
-    key.detuneCents = at("string.detune_cents");
-    instrument.keys.push_back(key);
-  }
+  instrument.name = values_.setting("name") ? values_.word("name")
+                                            : std::filesystem::path(source_).stem().string();
+  instrument.model = *values_.model;
+  instrument.lowestNote = static_cast<int>(values_.number("lowest_note"));
+  instrument.highestNote = static_cast<int>(values_.number("highest_note"));
+  instrument.polyphony = static_cast<int>(values_.number("polyphony"));
+  instrument.gainDb = values_.number("gain_dB");
+  instrument.panSpread = values_.number("pan_spread");
+  if (*values_.model == InstrumentModel::plate)
+    buildPlatePatch(values_, instrument);
+  else
+    buildStringKeys(values_, instrument);
   return instrument;
 }
 
 void Loader::checkVoices(const Instrument& instrument) {
-  const int lo = instrument.lowestNote, hi = instrument.highestNote;
-  std::set<int> notes{lo, hi};
-  if (instrument.model == InstrumentModel::plate) {
-    const int reference = instrument.plate.referenceNote;
-    if (reference >= lo && reference <= hi) notes.insert(reference);
-    for (int note : notes) try {
-        PlateVoice voice;
-        voice.prepare(instrument.plate, note, kCheckRate);
-      } catch (const std::exception& e) {
-        voiceError(e.what(), note);
-      }
-    return;
-  }
-  for (int note = lo; note <= hi; note += 12) notes.insert(note);
-  for (const Anchor& a : anchors_)
-    if (a.note >= lo && a.note <= hi) notes.insert(a.note);  // a --set may narrow the range
-  // The patches the synthesizer plays: the outermost unison strings carry the detune extremes.
-  for (int note : notes) try {
-      const int unisons = instrument.keys[note - lo].unisons;
-      for (int string : {0, unisons - 1}) {
-        StringVoice voice;
-        voice.prepare(unisonPatch(instrument, note, string), note, kCheckRate);
-      }
-    } catch (const std::exception& e) {
-      voiceError(e.what(), note);
-    }
+  const auto refused = [this](std::string_view message, int note) { voiceError(message, note); };
+  if (instrument.model == InstrumentModel::plate)
+    checkPlateVoices(instrument, refused);
+  else
+    checkStringVoices(instrument, values_, refused);
 }
 
 // Points the voice's complaint at the setting behind the field it names, once per setting.
@@ -991,22 +740,18 @@ void Loader::voiceError(std::string_view message, int note) {
   const std::string_view head = message.substr(0, colon);
   const std::string_view field = head.substr(0, head.find(" = "));
   const VoiceField* found = nullptr;
-  if (*model_ == InstrumentModel::string) {
-    for (const VoiceField& f : kStringFields)
-      if (f.field == field) found = &f;
-  } else {
-    for (const VoiceField& f : kPlateFields)
-      if (f.field == field) found = &f;
-  }
+  for (const VoiceField& f :
+       *values_.model == InstrumentModel::string ? stringVoiceFields() : plateVoiceFields())
+    if (f.field == field) found = &f;
   if (!found) {
-    const Setting* edge = note == number("lowest_note")    ? setting("lowest_note")
-                          : note == number("highest_note") ? setting("highest_note")
-                                                           : nullptr;
+    const Setting* edge = note == values_.number("lowest_note")    ? values_.setting("lowest_note")
+                          : note == values_.number("highest_note") ? values_.setting("highest_note")
+                                                                   : nullptr;
     error(edge ? edge->place : Place{}, noteName(note) + " (" + std::to_string(note) +
                                             "): " + std::string(message) + withOverrides({}));
     return;
   }
-  const Blame b = blame(row(found->parameter), note, true);
+  const Blame b = blame(values_.row(found->parameter), note, true);
   if (!voiceReported_.emplace(b.place, found->parameter).second) return;
   const std::string_view rest =
       found->keep || colon == std::string_view::npos ? message : message.substr(colon + 2);

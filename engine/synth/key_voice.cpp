@@ -1,5 +1,6 @@
-// The key's voices and their mix: each unison string is a StringVoice a few cents apart, or one
-// PlateVoice; the key's pan places it in the stereo image; a linear fade frees a stolen key.
+// The key's voice and its mix: the unison strings (UnisonStrings, each a StringVoice a few cents
+// apart) or one PlateVoice; the key's pan places it in the stereo image; a linear fade frees a
+// stolen key.
 #include "synth/key_voice.h"
 
 #include <algorithm>
@@ -12,33 +13,27 @@ namespace hamiltone {
 
 void KeyVoice::prepare(const Instrument& instrument, int note, double sampleRate, int maxBlock,
                        bool freeQuiet) {
-  std::vector<StringVoice> strings;
-  std::unique_ptr<PlateVoice> plate;
-  if (instrument.model == InstrumentModel::string) {
-    strings.resize(instrument.keys.at(note - instrument.lowestNote).unisons);
-    for (size_t s = 0; s < strings.size(); ++s)
-      strings[s].prepare(unisonPatch(instrument, note, static_cast<int>(s)), note, sampleRate);
-  } else {
-    plate = std::make_unique<PlateVoice>();
-    plate->prepare(instrument.plate, note, sampleRate);
-  }
+  std::variant<UnisonStrings, PlateVoice> voice;
+  if (instrument.model == InstrumentModel::string)
+    voice.emplace<UnisonStrings>().prepare(instrument, note, sampleRate);
+  else
+    voice.emplace<PlateVoice>().prepare(instrument.plate, note, sampleRate);
   // Constant-power pan across the keyboard, scaled so a centred key keeps unit gain per channel.
   const int span = std::max(1, instrument.highestNote - instrument.lowestNote);
   const double position =
       instrument.panSpread * (2.0 * (note - instrument.lowestNote) / span - 1.0);  // −1 … 1
   const double angle = (position + 1.0) * std::numbers::pi / 4.0;
-  strings_ = std::move(strings);
-  plate_ = std::move(plate);
+  voice_ = std::move(voice);
   panLeft_ = std::numbers::sqrt2 * std::cos(angle);
   panRight_ = std::numbers::sqrt2 * std::sin(angle);
   // A voice is silent under QuietDetector::kFloor of full scale at the instrument's output: in
   // its own units, divided by the instrument's gain and the louder side's pan, and shared among
   // the key's strings so that all of them together stay under it.
+  const UnisonStrings* strings = std::get_if<UnisonStrings>(&voice_);
   const double heard = std::pow(10.0, instrument.gainDb / 20.0) * std::max(panLeft_, panRight_) *
-                       static_cast<double>(std::max<size_t>(strings_.size(), 1));
+                       static_cast<double>(std::max<size_t>(strings ? strings->size() : 0, 1));
   const double floor = freeQuiet ? QuietDetector::kFloor / heard : -1.0;
-  for (StringVoice& s : strings_) s.setQuietFloor(floor);
-  if (plate_) plate_->setQuietFloor(floor);
+  std::visit([floor](auto& v) { v.setQuietFloor(floor); }, voice_);
   for (auto* buffer : {&voiceLeft_, &voiceRight_, &mixLeft_, &mixRight_, &outLeft_, &outRight_})
     buffer->assign(maxBlock, 0.0f);
   frames_ = 0;
@@ -66,8 +61,7 @@ void KeyVoice::strike(double velocity, long order) noexcept {
 
 void KeyVoice::strikeNow(double velocity) noexcept {
   loudest_ = envelope_;
-  for (StringVoice& s : strings_) s.noteOn(velocity);
-  if (plate_) plate_->noteOn(velocity);
+  std::visit([velocity](auto& v) { v.noteOn(velocity); }, voice_);
 }
 
 void KeyVoice::release(double damperScale) noexcept {
@@ -76,8 +70,7 @@ void KeyVoice::release(double damperScale) noexcept {
     damperScale_ = damperScale;
     return;
   }
-  for (StringVoice& s : strings_) s.release(damperScale);
-  if (plate_) plate_->release(damperScale);
+  std::visit([damperScale](auto& v) { v.release(damperScale); }, voice_);
 }
 
 void KeyVoice::fadeOut() noexcept {
@@ -88,7 +81,7 @@ void KeyVoice::fadeOut() noexcept {
 }
 
 void KeyVoice::setBend(double semitones) noexcept {
-  for (StringVoice& s : strings_) s.setBend(semitones);
+  if (UnisonStrings* strings = std::get_if<UnisonStrings>(&voice_)) strings->setBend(semitones);
 }
 
 double KeyVoice::level() const {
@@ -97,19 +90,16 @@ double KeyVoice::level() const {
 }
 
 bool KeyVoice::sounding() const {
-  for (const StringVoice& s : strings_)
-    if (s.active()) return true;
-  return plate_ && plate_->active();
+  return std::visit([](const auto& v) { return v.active(); }, voice_);
 }
 
 int KeyVoice::guardEvents() const {
-  int events = plate_ ? plate_->guardEvents() : 0;
-  for (const StringVoice& s : strings_) events += s.guardEvents();
-  return events;
+  return std::visit([](const auto& v) { return v.guardEvents(); }, voice_);
 }
 
 double KeyVoice::fundamentalHz() const {
-  return plate_ ? plate_->lowestModeHz() : strings_.front().fundamentalHz();
+  const PlateVoice* plate = std::get_if<PlateVoice>(&voice_);
+  return plate ? plate->lowestModeHz() : std::get_if<UnisonStrings>(&voice_)->fundamentalHz();
 }
 
 void KeyVoice::process(size_t frames, double gain) noexcept {
@@ -129,8 +119,7 @@ void KeyVoice::process(size_t frames, double gain) noexcept {
     render(left.subspan(done, length), right.subspan(done, length), gain);
     done += length;
     if (wasFading && !fading()) {  // free the voices; a pending strike starts next round
-      for (StringVoice& s : strings_) s.reset();
-      if (plate_) plate_->reset();
+      std::visit([](auto& v) { v.reset(); }, voice_);
       if (!pending()) break;
     }
   }
@@ -151,13 +140,14 @@ void KeyVoice::render(std::span<float> left, std::span<float> right, double gain
       mixR[i] += stereo ? voiceR[i] : voiceL[i];  // a mono voice feeds both channels
     }
   };
-  for (StringVoice& s : strings_) {
-    if (!s.active()) continue;
-    s.process(voiceL, voiceR);
-    add(s.channels() == 2);
-  }
-  if (plate_ && plate_->active()) {
-    plate_->process(voiceL, voiceR);
+  if (UnisonStrings* strings = std::get_if<UnisonStrings>(&voice_)) {
+    for (StringVoice& s : strings->strings()) {
+      if (!s.active()) continue;
+      s.process(voiceL, voiceR);
+      add(s.channels() == 2);
+    }
+  } else if (PlateVoice* plate = std::get_if<PlateVoice>(&voice_); plate->active()) {
+    plate->process(voiceL, voiceR);
     add(true);
   }
   const double gl = gain * panLeft_, gr = gain * panRight_;

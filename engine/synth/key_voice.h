@@ -1,12 +1,15 @@
-// One key of the synthesizer: the key's unison strings (or its plate), its place in the stereo
-// image, and the key's state — held, sustained by the pedal, released, or fading out when stolen.
+// One key of the synthesizer: its instrument's voice (the key's unison strings, or its plate), its
+// place in the stereo image, and the key's state — held, sustained by the pedal, released, or
+// fading out when stolen.
 #pragma once
 
-#include <memory>
 #include <span>
+#include <variant>
 #include <vector>
 
 #include "synth/instrument.h"
+#include "synth/unison_strings.h"
+#include "voices/plate_voice.h"
 
 namespace hamiltone {
 
@@ -57,8 +60,7 @@ class KeyVoice {
   void render(std::span<float> left, std::span<float> right, double gain) noexcept;
   void strikeNow(double velocity) noexcept;
 
-  std::vector<StringVoice> strings_;  // the unisons (string model)
-  std::unique_ptr<PlateVoice> plate_;
+  std::variant<UnisonStrings, PlateVoice> voice_;  // one voice type per instrument model
   std::vector<float> voiceLeft_, voiceRight_, mixLeft_, mixRight_, outLeft_, outRight_;
   size_t frames_ = 0;  // written to the outputs by the last process()
   double panLeft_ = 1.0, panRight_ = 1.0;

@@ -6,7 +6,7 @@
 #include <span>
 #include <vector>
 
-#include "models/plate.h"
+#include "instruments/plate.h"
 #include "schemes/sav.h"
 #include "voices/decimator.h"
 #include "voices/pickup.h"

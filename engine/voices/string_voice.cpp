@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "presets/piano_scale.h"
+#include "instruments/piano_scale.h"
 #include "util/format_number.h"
 #include "voices/voice_block.h"
 

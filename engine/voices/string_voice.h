@@ -6,8 +6,8 @@
 #include <optional>
 #include <span>
 
-#include "models/hammer.h"
-#include "models/string_tuning.h"
+#include "instruments/hammer.h"
+#include "instruments/string_tuning.h"
 #include "schemes/sav.h"
 #include "voices/decimator.h"
 #include "voices/pickup.h"

@@ -11,7 +11,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "models/hammer.h"
+#include "instruments/hammer.h"
 #include "schemes/sav.h"
 #include "support/energy_checks.h"
 

@@ -15,8 +15,8 @@
 #include <string_view>
 #include <vector>
 
+#include "instruments/piano_scale.h"
 #include "presets/parameters.h"
-#include "presets/piano_scale.h"
 
 namespace hamiltone {
 namespace {

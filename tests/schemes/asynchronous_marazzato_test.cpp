@@ -7,8 +7,8 @@
 #include <cmath>
 #include <vector>
 
-#include "models/inhomogeneous_wave.h"
-#include "models/slow_fast_fpu.h"
+#include "problems/inhomogeneous_wave.h"
+#include "problems/slow_fast_fpu.h"
 
 namespace hamiltone {
 namespace {

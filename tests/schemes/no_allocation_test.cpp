@@ -11,9 +11,9 @@
 #include <tuple>
 #include <vector>
 
-#include "models/hammer.h"
-#include "models/plate.h"
-#include "presets/piano_scale.h"
+#include "instruments/hammer.h"
+#include "instruments/piano_scale.h"
+#include "instruments/plate.h"
 #include "schemes/variable_step_sav.h"
 #include "support/fpu_runs.h"
 #include "support/player_performance.h"

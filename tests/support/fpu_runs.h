@@ -5,7 +5,7 @@
 #include <cmath>
 #include <vector>
 
-#include "models/fpu.h"
+#include "problems/fpu.h"
 #include "schemes/marazzato.h"
 #include "schemes/sav.h"
 #include "schemes/stormer_verlet.h"

@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "presets/piano_scale.h"
+#include "instruments/piano_scale.h"
 #include "synth/instrument.h"
 
 namespace hamiltone::testing {

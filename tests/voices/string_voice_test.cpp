@@ -8,7 +8,7 @@
 #include <cstdio>
 #include <vector>
 
-#include "presets/piano_scale.h"
+#include "instruments/piano_scale.h"
 #include "support/energy_checks.h"
 #include "support/modal.h"
 #include "support/spectrum.h"

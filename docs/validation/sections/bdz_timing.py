@@ -25,7 +25,7 @@ PROBLEMS = [("String", "Fig. 7: the geometrically exact string (§4.2.3), α = 3
 
 
 def bench_path(ctx):
-    """bench/hamiltone_bench_references of the build tree that holds ctx.sim (render/...)."""
+    """bench/hamiltone_bench_references of the build tree that holds ctx.sim (sim/...)."""
     tree = os.path.dirname(os.path.dirname(os.path.abspath(ctx.sim)))
     return os.path.join(tree, "bench", "hamiltone_bench_references")
 

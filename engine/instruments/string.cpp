@@ -1,0 +1,284 @@
+// The string's stiffness stencils and its split potential (65) with the gradient by the chain rule.
+#include "instruments/string.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+#include "instruments/grid.h"
+#include "util/format_number.h"
+
+namespace hamiltone {
+
+namespace {
+
+void requirePositive(const char* name, double value, const char* unit) {
+  if (!std::isfinite(value) || value <= 0.0)
+    throw std::invalid_argument(std::string(name) + " = " + formatNumber(value) +
+                                ": must be a finite number > 0 (" + unit + ")");
+}
+
+}  // namespace
+
+NonlinearString::NonlinearString(const StringPhysics& p, StringGrid grid)
+    : physics_(p), grid_(grid), segments_(grid.transverse) {
+  requirePositive("density", p.density, "kg/m^3");
+  requirePositive("area", p.area, "m^2");
+  requirePositive("length", p.length, "m");
+  requirePositive("young", p.young, "Pa");
+  requirePositive("tension", p.tension, "N");
+  if (!std::isfinite(p.inertia) || p.inertia < 0.0)
+    throw std::invalid_argument("inertia = " + formatNumber(p.inertia) +
+                                ": must be a finite number >= 0 (m^4)");
+  if (p.young * p.area <= p.tension)
+    throw std::invalid_argument("tension = " + formatNumber(p.tension) +
+                                " N: must be below E*A = " + formatApprox(p.young * p.area) +
+                                " N, or the split potential (65) is not >= 0");
+  if (grid.transverse < 2)
+    throw std::invalid_argument("segments = " + std::to_string(grid.transverse) + ": must be >= 2");
+  if (grid.longitudinal < 1 || grid.transverse % grid.longitudinal != 0)
+    throw std::invalid_argument("longitudinal segments = " + std::to_string(grid.longitudinal) +
+                                ": must be >= 1 and divide the " + std::to_string(grid.transverse) +
+                                " transverse segments");
+  ratio_ = grid.transverse / grid.longitudinal;
+  h_ = p.length / grid.transverse;
+  hv_ = p.length / grid.longitudinal;
+  const Eigen::Index nu = grid.transverse - 1, nv = grid.longitudinal - 1;
+  inverseMass_.resize(nu + nv);
+  inverseMass_.head(nu).setConstant(1.0 / (p.linearDensity() * h_));
+  inverseMass_.tail(nv).setConstant(1.0 / (p.linearDensity() * hv_));
+  for (Vector* w : {&work1_, &work2_}) w->setZero(grid.transverse);
+  work3_.setZero(grid.transverse + 1);
+  for (Vector* w : {&cell1_, &cell2_, &cell3_}) w->setZero(grid.longitudinal);
+  scratch_.setZero(4 * grid.transverse);
+}
+
+void NonlinearString::applyStiffness(const Vector& q, Vector& out) const {
+  const Eigen::Index n = segments_ - 1, nv = grid_.longitudinal - 1;
+  const double invH2 = 1.0 / (h_ * h_);
+  if (nv > 0)
+    kernels_->secondDifference(q.data() + n, out.data() + n, nv,
+                               -physics_.tension / hv_);  // −T0 h_v D2 v
+  const double t = tensionScale_ * physics_.tension * h_;
+  if (physics_.inertia == 0.0) {
+    kernels_->secondDifference(q.data(), out.data(), n, -t * invH2);  // −βT0 h D2 u
+    return;
+  }
+  // h (−βT0 D2 + EI D2²) u. D2² with D2 u = 0 at the ends is the simply supported biharmonic.
+  const double ei = physics_.young * physics_.inertia * h_;
+  double* d2u = work1_.data();
+  double* d4u = work2_.data();
+  kernels_->secondDifference(q.data(), d2u, n, invH2);
+  kernels_->secondDifference(d2u, d4u, n, invH2);
+  for (Eigen::Index j = 0; j < n; ++j) out[j] = -t * d2u[j] + ei * d4u[j];
+}
+
+double NonlinearString::transverseEigenvalue(int m) const {
+  return transverseEigenvalue(m, tensionScale_);
+}
+
+double NonlinearString::transverseEigenvalue(int m, double scale) const {
+  const double s = std::sin(m * std::numbers::pi / (2.0 * segments_));
+  const double rhoA = physics_.linearDensity();
+  const double h2 = h_ * h_;
+  return scale * physics_.tension / rhoA * 4.0 / h2 * s * s +
+         physics_.young * physics_.inertia / rhoA * 16.0 / (h2 * h2) * s * s * s * s;
+}
+
+double NonlinearString::longitudinalEigenvalue(int m) const {
+  const double s = std::sin(m * std::numbers::pi / (2.0 * grid_.longitudinal));
+  return physics_.tension / physics_.linearDensity() * 4.0 / (hv_ * hv_) * s * s;
+}
+
+void NonlinearString::setTensionRange(double maxScale) {
+  if (!(maxScale >= 1.0 && maxScale <= 4.0))
+    throw std::invalid_argument("tension scale range " + formatNumber(maxScale) +
+                                ": must be between 1 and 4 (two octaves of bend)");
+  tensionScaleMax_ = maxScale;
+  tensionScale_ = 1.0;
+}
+
+double NonlinearString::stiffnessEigenvalueMax() const {
+  // At the largest β the range allows; >= the longitudinal eigenvalue, mode by mode.
+  return transverseEigenvalue(segments_ - 1, tensionScaleMax_);
+}
+
+double NonlinearString::lossOperatorEigenvalueMax() const {
+  const double s = std::sin((segments_ - 1) * std::numbers::pi / (2.0 * segments_));
+  return 4.0 / (h_ * h_) * s * s;
+}
+
+void NonlinearString::applyLossOperator(const Vector& a, const Vector& b, Vector& out) const {
+  const Eigen::Index nu = segments_ - 1, nv = grid_.longitudinal - 1;
+  // M (−D2) = −ρA h D2 on each grid, with its own h.
+  const double rhoA = physics_.linearDensity();
+  kernels_->secondDifferenceOfDifference(a.data(), b.data(), out.data(), nu, -rhoA / h_);
+  if (nv > 0)
+    kernels_->secondDifferenceOfDifference(a.data() + nu, b.data() + nu, out.data() + nu, nv,
+                                           -rhoA / hv_);
+}
+
+namespace {
+
+// One segment's share of (65): with ζ, η its strains, returns (s − 1)² and sets φ (s − 1)/s, the
+// factor of ∂V'/∂ζ = c φ ζ and ∂V'/∂η = c φ (1 + η). s − 1 = (2η + η² + ζ²)/(s + 1): no
+// cancellation at small strain.
+inline double segmentExcess(double zeta, double eta, double& phi) {
+  const double stretch = std::sqrt((1.0 + eta) * (1.0 + eta) + zeta * zeta);
+  const double excess = (2.0 * eta + eta * eta + zeta * zeta) / (stretch + 1.0);
+  phi = excess / stretch;
+  return excess * excess;
+}
+
+}  // namespace
+
+double NonlinearString::splitPotential(const Vector& q) const {
+  return ratio_ == 1 ? singleGridPotential(q) : twoGridPotential(q);
+}
+
+double NonlinearString::splitGradient(const Vector& q, Vector& grad) const {
+  return ratio_ == 1 ? singleGridGradient(q, grad) : twoGridGradient(q, grad);
+}
+
+// ζ_l = D₋u, η_l = D₋v on the M segments (u_0 = u_M = 0); V' = h (EA − T0)/2 Σ (s_l − 1)².
+// The end segments are taken apart so the loop over the others has no branch and vectorises.
+double NonlinearString::singleGridPotential(const Vector& q) const {
+  const Eigen::Index m = segments_;
+  const double* u = q.data();
+  const double* v = q.data() + (m - 1);
+  const double invH = 1.0 / h_;
+  double phi;
+  double sum = segmentExcess(u[0] * invH, v[0] * invH, phi) +
+               segmentExcess(-u[m - 2] * invH, -v[m - 2] * invH, phi);
+#pragma omp simd reduction(+ : sum)
+  for (Eigen::Index l = 1; l < m - 1; ++l) {
+    double f;
+    sum += segmentExcess((u[l] - u[l - 1]) * invH, (v[l] - v[l - 1]) * invH, f);
+  }
+  return 0.5 * h_ * (physics_.young * physics_.area - physics_.tension) * sum;
+}
+
+namespace {
+
+// η_J = (v_J − v_{J−1}) / h_v on the Mv coarse cells, v = 0 beyond both ends.
+void longitudinalStrains(const double* v, Eigen::Index mv, double invHv, double* eta) {
+  if (mv == 1) {
+    eta[0] = 0.0;
+    return;
+  }
+  eta[0] = v[0] * invHv;
+  eta[mv - 1] = -v[mv - 2] * invHv;
+  for (Eigen::Index j = 1; j < mv - 1; ++j) eta[j] = (v[j] - v[j - 1]) * invHv;
+}
+
+// u (or v) with its fixed ends, up[0] = up[M] = 0, so that ζ_l = (up[l+1] − up[l]) / h on every
+// segment.
+void padded(const double* u, Eigen::Index m, double* up) {
+  up[0] = up[m] = 0.0;
+  std::copy(u, u + m - 1, up + 1);
+}
+
+}  // namespace
+
+// ∂V'/∂ζ_l = c φ_l ζ_l, ∂V'/∂η_l = c φ_l (1 + η_l), c = h (EA − T0); then
+// ∇_u V' = D₋ᵀ(∂V'/∂ζ): (D₋ᵀ w)_j = (w_j − w_{j+1}) / h, likewise for v.
+double NonlinearString::singleGridGradient(const Vector& q, Vector& grad) const {
+  const Eigen::Index m = segments_;
+  const double c = h_ * (physics_.young * physics_.area - physics_.tension);
+  double* up = work3_.data();
+  double* vp = scratch_.data();
+  padded(q.data(), m, up);
+  padded(q.data() + (m - 1), m, vp);
+  const double sum = kernels_->singleGridForces(up, vp, m, 1.0 / h_, c, work1_.data(),
+                                                work2_.data(), grad.data(), grad.data() + (m - 1));
+  return 0.5 * c * sum;
+}
+
+// ε_J = (1/r) Σ_{l∈J} (s_l − 1) into strain_J and Σ_{l∈J} 1/s_l into sumInverse_J, with ζ_l/s_l
+// into zetaOverS (SCHEMES §3b).
+void NonlinearString::cellStrains(const Vector& q, double* strain, double* sumInverse,
+                                  double* zetaOverS) const {
+  const Eigen::Index m = segments_, mv = grid_.longitudinal;
+  padded(q.data(), m, work3_.data());
+  longitudinalStrains(q.data() + (m - 1), mv, 1.0 / hv_, cell1_.data());
+  kernels_->cellStretches(work3_.data(), cell1_.data(), mv, ratio_, 1.0 / h_, scratch_.data(),
+                          zetaOverS, strain, sumInverse);
+}
+
+// SCHEMES §3b: ε_J = (1/r) Σ_{l∈J} (s_l − 1), V' = (EA − T0)/2 Σ_J h_v ε_J².
+double NonlinearString::twoGridPotential(const Vector& q) const {
+  double* strain = cell2_.data();
+  cellStrains(q, strain, cell3_.data(), work1_.data());
+  double sum = 0.0;
+  for (Eigen::Index j = 0; j < grid_.longitudinal; ++j) sum += strain[j] * strain[j];
+  return 0.5 * hv_ * (physics_.young * physics_.area - physics_.tension) * sum;
+}
+
+// With c = (EA − T0) h_u and w_l = c ε_J / s_l (SCHEMES §3b):
+//   ∂V'/∂ζ_l = w_l ζ_l,  ∂V'/∂η_J = Σ_{l∈J} w_l (1 + η_J) = c ε_J (1 + η_J) Σ_{l∈J} 1/s_l,
+// then ∇_u V' = D₋ᵀ(∂V'/∂ζ) on the fine grid and ∇_v V' = D₋ᵀ(∂V'/∂η) on the coarse one.
+double NonlinearString::twoGridGradient(const Vector& q, Vector& grad) const {
+  const Eigen::Index m = segments_, mv = grid_.longitudinal;
+  const double c = (physics_.young * physics_.area - physics_.tension) * h_;
+  double* zetaOverS = work1_.data();
+  double* strain = cell2_.data();
+  double* we = cell3_.data();  // Σ 1/s_l, then ∂V'/∂η_J
+  cellStrains(q, strain, we, zetaOverS);
+  const double* eta = cell1_.data();
+  double sum = 0.0;
+  for (Eigen::Index j = 0; j < mv; ++j) {
+    sum += strain[j] * strain[j];
+    we[j] *= c * strain[j] * (1.0 + eta[j]);
+  }
+  kernels_->fineForces(mv, ratio_, c, 1.0 / h_, strain, scratch_.data(), zetaOverS, grad.data());
+  double* gv = grad.data() + (m - 1);
+  const double invHv = 1.0 / hv_;
+  for (Eigen::Index j = 0; j < mv - 1; ++j) gv[j] = (we[j] - we[j + 1]) * invHv;
+  return 0.5 * hv_ * (physics_.young * physics_.area - physics_.tension) * sum;
+}
+
+double minimalSpacing(const StringPhysics& p, GridRule rule, double k, double sigma1) {
+  const double c2 = p.tension / p.linearDensity();
+  const double kappa2 = p.young * p.inertia / p.linearDensity();
+  const double a = c2 * k * k + 4.0 * sigma1 * k;
+  const double transverse = std::sqrt(0.5 * (a + std::sqrt(a * a + 16.0 * kappa2 * k * k)));
+  if (rule != GridRule::longitudinal) return transverse;  // two grids: u's spacing
+  return std::max(std::sqrt(p.young / p.density) * k, transverse);
+}
+
+int gridSegments(const StringPhysics& p, GridRule rule, double k, double sigma1, double factor) {
+  if (!(factor >= 1.0) || !std::isfinite(factor))
+    throw std::invalid_argument("grid factor = " + formatNumber(factor) + ": must be >= 1");
+  const double h = factor * minimalSpacing(p, rule, k, sigma1);
+  return segmentsAlong(
+      p.length, h, k, 1e6, "length",
+      rule == GridRule::longitudinal ? "h >= sqrt(E/rho) k" : "stiff-string bound (44)");
+}
+
+StringGrid stringGrid(const StringPhysics& p, GridRule rule, double k, double sigma1, double factor,
+                      double tensionMargin) {
+  if (rule != GridRule::twoGrid) {
+    const int m = gridSegments(p, rule, k, sigma1, factor);
+    return {m, m};
+  }
+  if (!(tensionMargin >= 1.0) || !std::isfinite(tensionMargin))
+    throw std::invalid_argument("tension margin = " + formatNumber(tensionMargin) +
+                                ": must be a finite number >= 1 (times the tension)");
+  StringPhysics design = p;
+  design.tension *= tensionMargin;
+  const int fine = gridSegments(design, GridRule::transverse, k, sigma1, factor);
+  const double cL = std::sqrt(p.young / p.density);
+  const double coarse = std::floor(p.length / (kLongitudinalGridFactor * cL * k));
+  const int mv = static_cast<int>(std::clamp(coarse, 1.0, static_cast<double>(fine)));
+  // u's grid rounded down to a multiple of Mv, or, where that loses more (Mv <= fine < 2 Mv, a
+  // string whose c_L is under twice c_T), r = ceil(fine / Mv) with fewer, longer coarse cells:
+  // either keeps u within the bound and v's Courant number below 1/1.05.
+  const StringGrid down{fine / mv * mv, mv};
+  const int r = (fine + mv - 1) / mv;
+  const StringGrid up{fine / r * r, fine / r};
+  return up.transverse > down.transverse ? up : down;
+}
+
+}  // namespace hamiltone

@@ -1,0 +1,125 @@
+// A string instrument from a preset: the patch every key shares, each key's string, hammer and
+// loss between the anchors, and which preset parameter each StringVoice field comes from.
+#include "presets/string_builder.h"
+
+#include <cmath>
+#include <exception>
+#include <numbers>
+#include <set>
+#include <string>
+
+#include "voices/string_voice.h"
+
+namespace hamiltone {
+
+namespace {
+
+constexpr VoiceField kStringFields[] = {
+    {"oversampling", "scheme.oversampling"},
+    {"a4_hz", "a4_Hz"},
+    {"damper_t60_s", "loss.damper_t60_s"},
+    {"pickup_position", "pickups.left_position"},
+    {"channels", "pickups.channels"},
+    {"gain", "pickups.gain"},
+    {"hammer_velocity_max_m_s", "hammer.velocity_max_m_s"},
+    {"velocity_curve", "hammer.velocity_curve"},
+    {"guard_energy_multiple", "scheme.guard_energy_multiple"},
+    {"epsilon_j", "scheme.epsilon_J"},
+    {"tension_margin", "scheme.tension_margin"},
+    {"bend_range_semitones", "bend_range_semitones"},
+    {"tension scale range", "bend_range_semitones", true},
+    {"t60_low_s", "loss.t60_low_s"},
+    {"t60_high_s", "loss.t60_high_s"},
+    {"t60_high_hz", "loss.t60_high_Hz"},
+    {"tension", "string.tension_N"},
+    {"length", "string.length_m"},
+    {"young", "string.young_Pa"},
+    {"grid factor", "scheme.grid_factor"},
+    {"hammer mass", "hammer.mass_kg"},
+    {"hammer stiffness", "hammer.stiffness_N_per_m_p"},
+    {"hammer exponent", "hammer.exponent"},
+    {"hammer position", "hammer.position"},
+    {"hammer width", "hammer.width_m"},
+};
+
+}  // namespace
+
+void buildStringKeys(const PresetValues& values, Instrument& instrument) {
+  auto number = [&](std::string_view name) { return values.number(name); };
+  auto word = [&](std::string_view name) { return values.word(name); };
+  instrument.bendRange = number("bend_range_semitones");
+  StringPatch common;
+  common.tuneBy = word("string.tune_by") == "tension" ? TuneBy::tension : TuneBy::length;
+  common.a4Hz = number("a4_Hz");
+  const std::string rule = word("scheme.grid_rule");
+  common.grid = rule == "two-grid"     ? GridRule::twoGrid
+                : rule == "transverse" ? GridRule::transverse
+                                       : GridRule::longitudinal;
+  common.gridFactor = number("scheme.grid_factor");
+  common.tensionMargin = number("scheme.tension_margin");
+  common.oversampling = static_cast<int>(number("scheme.oversampling"));
+  if (values.setting("scheme.epsilon_J")) common.epsilon = number("scheme.epsilon_J");
+  common.t60HighHz = number("loss.t60_high_Hz");
+  common.pickups[0] = number("pickups.left_position");
+  common.pickups[1] = number("pickups.right_position");
+  common.channels = static_cast<int>(number("pickups.channels"));
+  common.signal =
+      word("pickups.signal") == "velocity" ? PickupSignal::velocity : PickupSignal::displacement;
+  common.gain = number("pickups.gain");
+  common.velocityMin = number("hammer.velocity_min_m_s");
+  common.velocityMax = number("hammer.velocity_max_m_s");
+  common.velocityCurve = number("hammer.velocity_curve");
+  common.guardEnergyMultiple = number("scheme.guard_energy_multiple");
+  common.bendRange = instrument.bendRange;
+  common.hammer.width = number("hammer.width_m");
+  common.string.young = number("string.young_Pa");
+  const bool stiff = number("string.bending_stiffness") != 0.0;
+  const Parameter& linearDensity = values.row("string.linear_density_kg_m");
+  const bool densityGiven = values.setting(linearDensity.name) || values.anchored(linearDensity);
+
+  for (int note = instrument.lowestNote; note <= instrument.highestNote; ++note) {
+    auto at = [&](std::string_view name) { return values.atKey(values.row(name), note); };
+    StringKey key{.patch = common};
+    StringPatch& p = key.patch;
+    const double d = at("string.diameter_m");
+    p.string.area = std::numbers::pi * d * d / 4.0;
+    p.string.density =
+        densityGiven ? at(linearDensity.name) / p.string.area : number("string.density_kg_m3");
+    p.string.length = at("string.length_m");
+    p.string.tension = at("string.tension_N");
+    p.string.inertia = stiff ? std::numbers::pi * std::pow(d, 4) / 64.0 : 0.0;
+    p.hammer.mass = at("hammer.mass_kg");
+    p.hammer.stiffness = at("hammer.stiffness_N_per_m_p");
+    p.hammer.exponent = at("hammer.exponent");
+    p.hammer.position = at("hammer.position");
+    p.t60Low = at("loss.t60_low_s");
+    p.t60High = at("loss.t60_high_s");
+    p.damperT60 = at("loss.damper_t60_s");
+    key.unisons = static_cast<int>(at("string.unisons"));
+    key.detuneCents = at("string.detune_cents");
+    instrument.keys.push_back(key);
+  }
+}
+
+void checkStringVoices(const Instrument& instrument, const PresetValues& values,
+                       const std::function<void(std::string_view message, int note)>& refused) {
+  const int lo = instrument.lowestNote, hi = instrument.highestNote;
+  std::set<int> notes{lo, hi};
+  for (int note = lo; note <= hi; note += 12) notes.insert(note);
+  for (const Anchor& a : values.anchors)
+    if (a.note >= lo && a.note <= hi) notes.insert(a.note);  // a --set may narrow the range
+  // The patches the synthesizer plays: the outermost unison strings carry the detune extremes.
+  for (int note : notes) try {
+      const int unisons = instrument.keys[note - lo].unisons;
+      for (int string : {0, unisons - 1}) {
+        StringVoice voice;
+        voice.prepare(unisonPatch(instrument, note, string), note, kCheckRate);
+      }
+    } catch (const std::exception& e) {
+      refused(e.what(), note);
+    }
+}
+
+std::span<const VoiceField> stringVoiceFields() { return kStringFields; }
+
+}  // namespace hamiltone

@@ -1,0 +1,306 @@
+// The string model: ∇V' is the derivative of V' (65) and of its two-grid form (SCHEMES §3b), K has
+// the closed-form spectrum the tuning and the bound (44) rely on, the loss operator is −ρA h D2 on
+// each grid, one coarse cell is the Kirchhoff–Carrier string, the grid rules size the grids as
+// documented, and unphysical strings are refused.
+#include "instruments/string.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include "instruments/piano_scale.h"
+#include "instruments/string_tuning.h"
+#include "schemes/sav.h"
+#include "support/energy_checks.h"
+
+namespace hamiltone {
+namespace {
+
+// The paper's C3 string (BDZ §4.2.3) with its steel core's bending stiffness, d = 1.063 mm.
+StringPhysics c3(bool stiff = true) {
+  StringPhysics p;
+  if (stiff) p.inertia = std::numbers::pi * std::pow(1.063e-3, 4) / 64.0;
+  return p;
+}
+
+using testing::randomVector;
+
+Eigen::MatrixXd matrixOf(const NonlinearString& s, auto apply) {
+  const Eigen::Index n = s.size();
+  Eigen::MatrixXd a(n, n);
+  Vector e(n), col(n);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    e.setZero();
+    e[j] = 1.0;
+    apply(e, col);
+    a.col(j) = col;
+  }
+  return a;
+}
+
+// Random states of a few mm transverse and a few µm longitudinal, like a struck piano string;
+// a relative 1e-6 against central differences leaves room for O(δ²) and for roundoff ~ 1e-16 V'/δ.
+// On the single grid of (65), on nested grids of 5 and 8 fine segments per cell, and on one cell.
+TEST(NonlinearString, GradientIsTheDerivativeOfTheSplitPotential) {
+  for (const StringGrid grid :
+       {StringGrid{40, 40}, StringGrid{40, 8}, StringGrid{40, 5}, StringGrid{40, 1}}) {
+    const NonlinearString string(c3(), grid);
+    const Eigen::Index n = string.size(), nu = string.transverseSize();
+    Vector grad(n);
+    for (unsigned seed = 0; seed < 4; ++seed) {
+      Vector q = randomVector(n, 3e-3, seed);
+      q.tail(n - nu) *= 1e-3;
+      const double v = string.splitGradient(q, grad);
+      EXPECT_DOUBLE_EQ(v, string.splitPotential(q));
+      testing::expectGradientIsDerivative([&](const Vector& x) { return string.splitPotential(x); },
+                                          grad, q,
+                                          [&](Eigen::Index j) { return j < nu ? 1e-7 : 1e-10; },
+                                          1e-6, 1e-9 * grad.cwiseAbs().maxCoeff());
+    }
+  }
+}
+
+// The strain averaged over a cell: with every fine segment of a cell stretched alike the cell's
+// mean is that stretch, so V' of the nested grids equals V' of the single grid whose v follows the
+// coarse one — here u is a triangle whose kinks sit on the cell boundaries (|ζ| the same in each
+// cell) and v is linear in each cell.
+TEST(NonlinearString, TwoGridPotentialAveragesTheStrainOverEachCell) {
+  const int r = 4, mv = 6, mu = r * mv;
+  const NonlinearString nested(c3(), StringGrid{mu, mv}), single(c3(), mu);
+  Vector qn = Vector::Zero(nested.size()), qs = Vector::Zero(single.size());
+  const double peak = 4e-3, stretch = 2e-6;
+  for (int j = 1; j < mu; ++j) {  // u: up over the first half, down over the second
+    qn[j - 1] = qs[j - 1] = peak * (j <= mu / 2 ? j : mu - j) / (mu / 2.0);
+  }
+  for (int cell = 1; cell < mv; ++cell)  // v at the coarse points, a zigzag
+    qn[mu - 1 + cell - 1] = stretch * (cell % 2);
+  for (int j = 1; j < mu; ++j)  // the same v, linear in each cell, on the fine grid
+    qs[mu - 1 + j - 1] = stretch * (j / r % 2 == 0 ? double(j % r) / r : 1.0 - double(j % r) / r);
+  EXPECT_NEAR(nested.splitPotential(qn), single.splitPotential(qs),
+              1e-12 * single.splitPotential(qs));
+}
+
+// Mv = 1 leaves no longitudinal unknown: V' = (EA − T0) L ε² / 2 with ε = (ℓ − L)/L, ℓ the discrete
+// length of the string, and the force on u is that of the extra tension (EA − T0) ε along each
+// segment: ∂V'/∂ζ_l = h (EA − T0) ε ζ_l / s_l — Kirchhoff–Carrier's tension from the mean strain,
+// with the segment's direction cosine exact.
+TEST(NonlinearString, OneCellIsTheKirchhoffCarrierString) {
+  const StringPhysics p = c3();
+  const int mu = 30;
+  const NonlinearString string(p, StringGrid{mu, 1});
+  ASSERT_EQ(string.size(), mu - 1);
+  const Vector q = randomVector(string.size(), 5e-3, 3);
+  const double h = string.spacing();
+  std::vector<double> zeta(mu), s(mu);
+  double length = 0.0;
+  for (int l = 0; l < mu; ++l) {
+    zeta[l] = ((l < mu - 1 ? q[l] : 0.0) - (l > 0 ? q[l - 1] : 0.0)) / h;
+    s[l] = std::sqrt(1.0 + zeta[l] * zeta[l]);
+    length += h * s[l];
+  }
+  const double strain = (length - p.length) / p.length, ea = p.young * p.area - p.tension;
+  const double expected = 0.5 * ea * p.length * strain * strain;
+  Vector grad(string.size());
+  EXPECT_NEAR(string.splitGradient(q, grad), expected, 1e-9 * expected);
+  for (int j = 0; j < mu - 1; ++j) {  // D₋ᵀ of the segment forces
+    const double force = ea * strain * (zeta[j] / s[j] - zeta[j + 1] / s[j + 1]);
+    EXPECT_NEAR(grad[j], force, 1e-9 * ea * strain) << j;
+  }
+}
+
+TEST(NonlinearString, SplitPotentialIsTheGeometricExcessEnergy) {
+  // u_1 = a alone: segments 1 and 2 get ζ = ±a/h and η = 0, so s − 1 = (a/h)² / (s + 1).
+  const NonlinearString string(c3(false), 4);
+  Vector q = Vector::Zero(string.size());
+  const double a = 1e-3, h = string.spacing();
+  q[0] = a;
+  const double z2 = (a / h) * (a / h);
+  const double excess = z2 / (std::sqrt(1.0 + z2) + 1.0);
+  const double expected = h * (2.02e11 * 8.87e-7 - 759.0) / 2.0 * 2.0 * excess * excess;
+  EXPECT_NEAR(string.splitPotential(q), expected, 1e-12 * expected);
+}
+
+TEST(NonlinearString, StiffnessHasTheClosedFormSpectrum) {
+  for (const StringGrid grid : {StringGrid{30, 30}, StringGrid{30, 6}, StringGrid{30, 1}}) {
+    const NonlinearString string(c3(), grid);
+    const Eigen::MatrixXd k =
+        matrixOf(string, [&](const Vector& x, Vector& y) { string.applyStiffness(x, y); });
+    EXPECT_LE((k - k.transpose()).cwiseAbs().maxCoeff(), 1e-12 * k.cwiseAbs().maxCoeff());
+    // M⁻¹K eigenvalues (of the symmetric M^-½ K M^-½): the two families of the header.
+    const Vector root = string.inverseMass().cwiseSqrt();
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(root.asDiagonal() * k * root.asDiagonal());
+    std::vector<double> expected;
+    for (int m = 1; m < grid.transverse; ++m) expected.push_back(string.transverseEigenvalue(m));
+    for (int m = 1; m < grid.longitudinal; ++m)
+      expected.push_back(string.longitudinalEigenvalue(m));
+    std::sort(expected.begin(), expected.end());
+    for (size_t i = 0; i < expected.size(); ++i)
+      EXPECT_NEAR(eig.eigenvalues()[static_cast<Eigen::Index>(i)], expected[i],
+                  1e-9 * expected.back());
+    EXPECT_NEAR(eig.eigenvalues().maxCoeff(), string.stiffnessEigenvalueMax(),
+                1e-9 * expected.back());
+  }
+}
+
+TEST(NonlinearString, LossOperatorIsMinusRhoAhD2OfTheDifference) {
+  for (const StringGrid grid : {StringGrid{12, 12}, StringGrid{12, 4}}) {
+    const NonlinearString string(c3(), grid);
+    const Eigen::Index n = string.size();
+    const Vector a = randomVector(n, 1.0, 7), b = randomVector(n, 1.0, 8);
+    Vector out(n);
+    string.applyLossOperator(a, b, out);
+    const Eigen::MatrixXd c = matrixOf(string, [&](const Vector& x, Vector& y) {
+      string.applyLossOperator(x, Vector::Zero(n), y);
+    });
+    EXPECT_LE((c * (a - b) - out).cwiseAbs().maxCoeff(), 1e-12 * out.cwiseAbs().maxCoeff());
+    // M⁻¹C = −D2 on each grid: eigenvalues (4/h²) sin²(mπ/2M), the largest on u's grid.
+    const Vector root = string.inverseMass().cwiseSqrt();
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(root.asDiagonal() * c * root.asDiagonal());
+    EXPECT_GE(eig.eigenvalues().minCoeff(), 0.0);
+    EXPECT_NEAR(eig.eigenvalues().maxCoeff(), string.lossOperatorEigenvalueMax(),
+                1e-9 * string.lossOperatorEigenvalueMax());
+    // The smallest is v's first mode: the coarser grid's −D2 sits further below (π/L)².
+    const double hv = string.longitudinalSpacing();
+    EXPECT_NEAR(
+        eig.eigenvalues().minCoeff(),
+        4.0 / (hv * hv) * std::pow(std::sin(std::numbers::pi / (2.0 * grid.longitudinal)), 2),
+        1e-9 * string.lossOperatorEigenvalueMax())
+        << grid.longitudinal;
+  }
+}
+
+// The paper's first-mode start (70) at α = 300 and the extreme α = 1000 (u = 0.94 m on a 1.26 m
+// string), on the transverse grid at 48 kHz where the longitudinal wave is far from resolved:
+// (38) keeps its energy (41) for 2 s and the state finite. Roundoff: ~1e5 steps.
+TEST(NonlinearString, LargeAmplitudeStartsConserveEnergyAtAudioRate) {
+  const double k = 1.0 / 48000.0;
+  const StringPhysics p = c3();
+  const NonlinearString string(p, gridSegments(p, GridRule::transverse, k, 0.0, 1.0));
+  for (double alpha : {300.0, 1000.0}) {
+    Vector u = Vector::Zero(string.size());
+    for (int j = 1; j < string.segments(); ++j)
+      u[j - 1] = alpha * std::sqrt(p.area) * std::sin(std::numbers::pi * j / string.segments());
+    SplitSav<NonlinearString> scheme(string, {.k = k}, {u, Vector::Zero(string.size())});
+    const double h0 = scheme.energy().total();
+    double worst = 0.0;
+    for (long n = 0; n < 96000; ++n) {
+      scheme.step();
+      worst = std::max(worst, std::abs(scheme.energy().total() - h0) / h0);
+    }
+    EXPECT_LE(worst, 1e-10) << "alpha " << alpha;
+    EXPECT_TRUE(scheme.qNext().allFinite()) << "alpha " << alpha;
+  }
+}
+
+// Both losses at audio rate on the string alone, from the α = 10 start: the energy never
+// rises and the balance (50) closes over 2 s.
+TEST(NonlinearString, LossBalanceClosesAtAudioRate) {
+  const double k = 1.0 / 48000.0, sigma1 = 1e-3;
+  const StringPhysics p = c3();
+  const NonlinearString string(p, gridSegments(p, GridRule::transverse, k, sigma1, 1.0));
+  Vector u = Vector::Zero(string.size());
+  for (int j = 1; j < string.segments(); ++j)
+    u[j - 1] = 10.0 * std::sqrt(p.area) * std::sin(std::numbers::pi * j / string.segments());
+  SplitSav<NonlinearString> scheme(string, {.k = k, .sigma0 = 1.0, .sigma1 = sigma1},
+                                   {u, Vector::Zero(string.size())});
+  const testing::Balance b = testing::runBalance(scheme, 96000);
+  EXPECT_LE(b.worstIncrease, 1e-14);
+  EXPECT_LE(b.worstBalance, 1e-10);
+  EXPECT_LT(b.final, 0.1 * b.initial);
+}
+
+// The extremes of the keyboard, tuned, on the transverse grid at 44.1 and 192 kHz, started at
+// α = 1000: finite, and (41) kept to 1e-10 over 0.3 s.
+TEST(NonlinearString, KeyboardExtremesAtAlpha1000) {
+  for (double rate : {44100.0, 192000.0}) {
+    for (int note : {21, 108}) {
+      const double k = 1.0 / rate;
+      const TunedString tuned = tuneString(pianoString(note), TuneBy::tension, GridRule::transverse,
+                                           k, 0.0, 1.0, equalTemperament(note));
+      const NonlinearString string(tuned.physics, tuned.grid);
+      Vector u = Vector::Zero(string.size());
+      for (int j = 1; j < string.segments(); ++j)
+        u[j - 1] = 1000.0 * std::sqrt(tuned.physics.area) *
+                   std::sin(std::numbers::pi * j / string.segments());
+      SplitSav<NonlinearString> scheme(string, {.k = k}, {u, Vector::Zero(string.size())});
+      const double h0 = scheme.energy().total();
+      double worst = 0.0;
+      for (long n = 0; n < std::lround(0.3 * rate); ++n) {
+        scheme.step();
+        worst = std::max(worst, std::abs(scheme.energy().total() - h0) / h0);
+      }
+      EXPECT_LE(worst, 1e-10) << note << " at " << rate;
+      EXPECT_TRUE(scheme.qNext().allFinite()) << note << " at " << rate;
+    }
+  }
+}
+
+// SCHEMES §3b's sizing on the paper's C3 at 48 kHz: v on floor(L / (1.05 c_L k)) = 11 cells
+// (Courant c_L k / h_v <= 1/1.05), u on the finest grid the stiff-string bound allows at 1.5 T0
+// (124 segments) rounded down to a multiple of 11: 121, 130 unknowns. Sized for T0 instead, u
+// would have 136 segments. A treble string shorter than c_L k has a single cell (Mv = 1).
+TEST(StringGrids, TwoGridsAreNestedAndSizedForTheDesignTension) {
+  const double k = 1.0 / 48000.0;
+  const StringPhysics p = c3();
+  const double cL = std::sqrt(p.young / p.density);
+  const StringGrid grid = stringGrid(p, GridRule::twoGrid, k, 0.0, 1.0, 1.5);
+  EXPECT_EQ(grid.longitudinal, static_cast<int>(p.length / (1.05 * cL * k)));
+  EXPECT_EQ(grid.longitudinal, 11);
+  EXPECT_EQ(grid.transverse % grid.longitudinal, 0);
+  StringPhysics design = p;
+  design.tension *= 1.5;
+  const int finest = gridSegments(design, GridRule::transverse, k, 0.0, 1.0);
+  EXPECT_EQ(finest, 124);
+  EXPECT_EQ(grid.transverse, finest / 11 * 11);
+  EXPECT_LE(cL * k / (p.length / grid.longitudinal), 1.0 / 1.05 + 1e-12);
+  EXPECT_GT(gridSegments(p, GridRule::transverse, k, 0.0, 1.0), grid.transverse);
+  EXPECT_EQ(NonlinearString(p, grid).size(), 130);
+  // The other rules keep one grid.
+  const StringGrid single = stringGrid(p, GridRule::transverse, k, 0.0, 1.0, 1.5);
+  EXPECT_EQ(single.transverse, single.longitudinal);
+  EXPECT_EQ(single.transverse, gridSegments(p, GridRule::transverse, k, 0.0, 1.0));
+  StringPhysics treble = p;
+  treble.length = 0.9 * cL * k;  // 9.5 cm
+  EXPECT_EQ(stringGrid(treble, GridRule::twoGrid, k, 0.0, 1.0, 1.5).longitudinal, 1);
+  EXPECT_THROW(stringGrid(p, GridRule::twoGrid, k, 0.0, 1.0, 0.9), std::invalid_argument);
+  // A string whose longitudinal wave is under twice as fast as its transverse one (EA = 2.25 T0):
+  // rounding u's grid down to a multiple of Mv would halve it; fewer, longer cells keep it.
+  StringPhysics slack = p;
+  slack.young = 2.25 * p.tension / p.area;
+  StringPhysics slackDesign = slack;
+  slackDesign.tension *= 1.5;
+  const int slackFinest = gridSegments(slackDesign, GridRule::transverse, k, 0.0, 1.0);
+  const StringGrid kept = stringGrid(slack, GridRule::twoGrid, k, 0.0, 1.0, 1.5);
+  EXPECT_EQ(kept.transverse % kept.longitudinal, 0);
+  EXPECT_GE(kept.transverse, slackFinest - 1);
+  EXPECT_LE(std::sqrt(slack.young / slack.density) * k / (slack.length / kept.longitudinal),
+            1.0 / 1.05 + 1e-12);
+}
+
+TEST(NonlinearString, RefusesUnphysicalStrings) {
+  auto with = [](auto change) {
+    StringPhysics p = c3();
+    change(p);
+    return p;
+  };
+  EXPECT_THROW(NonlinearString(with([](auto& p) { p.density = 0; }), 10), std::invalid_argument);
+  EXPECT_THROW(NonlinearString(with([](auto& p) { p.area = -1; }), 10), std::invalid_argument);
+  EXPECT_THROW(NonlinearString(with([](auto& p) { p.length = NAN; }), 10), std::invalid_argument);
+  EXPECT_THROW(NonlinearString(with([](auto& p) { p.inertia = -1; }), 10), std::invalid_argument);
+  try {
+    NonlinearString(with([](auto& p) { p.tension = 2e5; }), 10);  // EA ≈ 1.79e5 N
+    FAIL() << "EA <= T0 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("tension"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(NonlinearString(c3(), 1), std::invalid_argument);
+  EXPECT_THROW(NonlinearString(c3(), StringGrid{12, 5}), std::invalid_argument);  // not nested
+  EXPECT_THROW(NonlinearString(c3(), StringGrid{12, 0}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace hamiltone
