@@ -1,6 +1,8 @@
-// The plate's stencils (DΔ, ℓ of (78)), the exact Airy solve by dense 2-D DST-I, and V', ∇V' (81).
+// The plate's stencils (DΔ, ℓ of (78)), the exact Airy solve by dense 2-D DST-I, and V', ∇V' (81),
+// on the kernels' loops.
 #include "models/plate.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -49,21 +51,22 @@ VonKarmanPlate::VonKarmanPlate(const PlatePhysics& p, int segmentsX, int segment
   hy_ = p.ly / segmentsY;
   const Eigen::Index n = static_cast<Eigen::Index>(nx_) * ny_;
   inverseMass_ = Vector::Constant(n, 1.0 / (p.density * p.thickness * hx_ * hy_));
-  sx_ = dst1(nx_);
+  px_ = nx_ + 2;
+  rows_ = (nx_ + 7) / 8 * 8;
+  sx_.setZero(rows_, nx_);
+  sx_.topRows(nx_) = dst1(nx_);
   sy_ = dst1(ny_);
-  inverseSquared_.resize(nx_, ny_);
+  inverseSquared_.setZero(rows_, ny_);
   for (int i = 0; i < nx_; ++i)
     for (int j = 0; j < ny_; ++j)
       inverseSquared_(i, j) = 1.0 / std::pow(laplacianEigenvalue(i + 1, j + 1), 2);
   airy_.setZero(n);
   work_.setZero(n);
   lap_.setZero(n);
-  spectral_.setZero(nx_, ny_);
-  half_.setZero(nx_, ny_);
-  padF_.setZero(static_cast<Eigen::Index>(nx_ + 2) * (ny_ + 2));
-  padG_.setZero(padF_.size());
-  cellF_.setZero(static_cast<Eigen::Index>(nx_ + 1) * (ny_ + 1));
-  cellG_.setZero(cellF_.size());
+  spectral_.setZero(rows_, ny_);
+  half_.setZero(rows_, ny_);
+  const Eigen::Index bordered = px_ * (ny_ + 2);
+  for (Vector* v : {&paddedQ_, &cellsQ_, &paddedF_, &cellsF_, &paddedOut_}) v->setZero(bordered);
 }
 
 double VonKarmanPlate::laplacianEigenvalue(int i, int j) const {
@@ -77,22 +80,32 @@ double VonKarmanPlate::stiffnessEigenvalueMax() const {
   return d * std::pow(laplacianEigenvalue(nx_, ny_), 2);
 }
 
-void VonKarmanPlate::laplacian(const Vector& f, Vector& out) const {
-  const double cx = 1.0 / (hx_ * hx_), cy = 1.0 / (hy_ * hy_);
+void VonKarmanPlate::pad(const double* v, Vector& padded) const {
   for (int m = 0; m < ny_; ++m)
-    for (int l = 0; l < nx_; ++l) {
-      const Eigen::Index i = l + static_cast<Eigen::Index>(nx_) * m;
-      const double c = f[i];
-      const double w = l > 0 ? f[i - 1] : 0.0, e = l + 1 < nx_ ? f[i + 1] : 0.0;
-      const double s = m > 0 ? f[i - nx_] : 0.0, nn = m + 1 < ny_ ? f[i + nx_] : 0.0;
-      out[i] = cx * (w - 2.0 * c + e) + cy * (s - 2.0 * c + nn);
-    }
+    std::copy_n(v + static_cast<Eigen::Index>(nx_) * m, nx_, padded.data() + 1 + px_ * (m + 1));
+}
+
+void VonKarmanPlate::unpad(const Vector& padded, double scale, Vector& out) const {
+  for (int m = 0; m < ny_; ++m) {
+    const double* row = padded.data() + 1 + px_ * (m + 1);
+    double* o = out.data() + static_cast<Eigen::Index>(nx_) * m;
+    for (int l = 0; l < nx_; ++l) o[l] = row[l] * scale;
+  }
+}
+
+void VonKarmanPlate::laplacian(const Vector& f, Vector& out) const {
+  pad(f.data(), paddedF_);
+  kernels_->gridLaplacian(paddedF_.data(), px_, ny_, 1.0 / (hx_ * hx_), 1.0 / (hy_ * hy_),
+                          paddedOut_.data());
+  unpad(paddedOut_, 1.0, out);
 }
 
 void VonKarmanPlate::applyStiffness(const Vector& q, Vector& out) const {
-  laplacian(q, lap_);
-  laplacian(lap_, out);
-  out *= physics_.rigidity() * hx_ * hy_;
+  const double cx = 1.0 / (hx_ * hx_), cy = 1.0 / (hy_ * hy_);
+  pad(q.data(), paddedF_);
+  kernels_->gridLaplacian(paddedF_.data(), px_, ny_, cx, cy, paddedOut_.data());
+  kernels_->gridLaplacian(paddedOut_.data(), px_, ny_, cx, cy, paddedF_.data());
+  unpad(paddedF_, physics_.rigidity() * hx_ * hy_, out);
 }
 
 void VonKarmanPlate::applyLossOperator(const Vector& a, const Vector& b, Vector& out) const {
@@ -102,60 +115,46 @@ void VonKarmanPlate::applyLossOperator(const Vector& a, const Vector& b, Vector&
 }
 
 void VonKarmanPlate::solveBiharmonic(const Vector& rhs, Vector& f) const {
-  const Eigen::Map<const Eigen::MatrixXd> r(rhs.data(), nx_, ny_);
-  Eigen::Map<Eigen::MatrixXd> out(f.data(), nx_, ny_);
-  // Eigen's blocked products: at 30 × 30 twice as fast as coefficient-wise ones; their blocking
-  // buffers live on the stack at these sizes (the no-allocation test covers the plate).
-  half_.noalias() = sx_ * r;
-  spectral_.noalias() = half_ * sy_;
+  // S_x R S_y, scaled by 1/λ², and back: four products of rows_ (a multiple of 8) rows.
+  const long rows = rows_, nx = nx_, ny = ny_;
+  kernels_->matrixProduct(sx_.data(), rows, rhs.data(), nx, half_.data(), rows, rows, nx, ny);
+  kernels_->matrixProduct(half_.data(), rows, sy_.data(), ny, spectral_.data(), rows, rows, ny, ny);
   spectral_.array() *= inverseSquared_.array();
-  half_.noalias() = sx_ * spectral_;
-  out.noalias() = half_ * sy_;
+  kernels_->matrixProduct(sx_.data(), rows, spectral_.data(), rows, half_.data(), rows, rows, nx,
+                          ny);
+  kernels_->matrixProduct(half_.data(), rows, sy_.data(), ny, spectral_.data(), rows, rows, ny, ny);
+  Eigen::Map<Eigen::MatrixXd>(f.data(), nx_, ny_) = spectral_.topRows(nx_);
 }
 
-// (78): ℓ(f,g) = D_xx f D_yy g + D_yy f D_xx g − ½ Σ_± D_{x±}D_{y±} f · D_{x±}D_{y±} g. On arrays
-// padded with the zero boundary, each mixed difference at a point is a cell difference
-// c(l, m) = f(l+1, m+1) − f(l+1, m) − f(l, m+1) + f(l, m) of one of the four cells around it, so
-// both are computed once per array and the point loop has no branch.
-void VonKarmanPlate::bracket(const Vector& f, const Vector& g, Vector& out) const {
-  const int px = nx_ + 2;  // padded row length
-  const int cx = nx_ + 1;  // cells per row
-  auto pad = [&](const Vector& v, Vector& padded, Vector& cells) {
-    for (int m = 0; m < ny_; ++m)
-      for (int l = 0; l < nx_; ++l) padded[(l + 1) + px * (m + 1)] = v[l + nx_ * m];
-    for (int m = 0; m <= ny_; ++m)
-      for (int l = 0; l <= nx_; ++l) {
-        const double* p = padded.data() + l + px * m;
-        cells[l + cx * m] = p[px + 1] - p[1] - p[px] + p[0];
-      }
-  };
-  pad(f, padF_, cellF_);
-  pad(g, padG_, cellG_);
+// ℓ(f, g) of (78), on bordered copies: each mixed difference at a point is a cell difference of one
+// of the four cells around it, so the cells are computed once per grid and the point loop has no
+// branch.
+void VonKarmanPlate::bordered(const Vector& f, const Vector& g) const {
+  pad(f.data(), paddedQ_);
+  kernels_->gridCells(paddedQ_.data(), px_, ny_, cellsQ_.data());
+  const Vector* gp = &paddedQ_;
+  const Vector* gc = &cellsQ_;
+  if (&g != &f) {
+    pad(g.data(), paddedF_);
+    kernels_->gridCells(paddedF_.data(), px_, ny_, cellsF_.data());
+    gp = &paddedF_;
+    gc = &cellsF_;
+  }
   const double ix2 = 1.0 / (hx_ * hx_), iy2 = 1.0 / (hy_ * hy_),
                ixy2 = 1.0 / (hx_ * hy_ * hx_ * hy_);
-  for (int m = 0; m < ny_; ++m) {
-    const double* fp = padF_.data() + 1 + px * (m + 1);  // the point (l, m) at fp[l]
-    const double* gp = padG_.data() + 1 + px * (m + 1);
-    const double* fc = cellF_.data() + cx * m;  // cells (l−1 … l, m−1 … m) at fc[l], fc[l+1], …
-    const double* gc = cellG_.data() + cx * m;
-    double* o = out.data() + nx_ * m;
-#pragma omp simd
-    for (int l = 0; l < nx_; ++l) {
-      const double fxx = (fp[l - 1] - 2.0 * fp[l] + fp[l + 1]) * ix2;
-      const double fyy = (fp[l - px] - 2.0 * fp[l] + fp[l + px]) * iy2;
-      const double gxx = (gp[l - 1] - 2.0 * gp[l] + gp[l + 1]) * ix2;
-      const double gyy = (gp[l - px] - 2.0 * gp[l] + gp[l + px]) * iy2;
-      // cells around point (l, m): (l−1, m−1) … (l, m), i.e. fc[l], fc[l+1], fc[l+cx], fc[l+1+cx]
-      const double cross = fc[l] * gc[l] + fc[l + 1] * gc[l + 1] + fc[l + cx] * gc[l + cx] +
-                           fc[l + 1 + cx] * gc[l + 1 + cx];
-      o[l] = fxx * gyy + fyy * gxx - 0.5 * cross * ixy2;
-    }
-  }
+  kernels_->gridBracket(paddedQ_.data(), gp->data(), cellsQ_.data(), gc->data(), px_, ny_, ix2,
+                        iy2, ixy2, paddedOut_.data());
+}
+
+void VonKarmanPlate::bracket(const Vector& f, const Vector& g, Vector& out) const {
+  bordered(f, g);
+  unpad(paddedOut_, 1.0, out);
 }
 
 double VonKarmanPlate::airyAndPotential(const Vector& q) const {
-  bracket(q, q, work_);
-  work_ *= -0.5 * physics_.young * physics_.thickness;  // DΔΔ F = −(Eξ/2) ℓ(q, q)   (79)
+  bordered(q, q);
+  // DΔΔ F = −(Eξ/2) ℓ(q, q)   (79)
+  unpad(paddedOut_, -0.5 * physics_.young * physics_.thickness, work_);
   solveBiharmonic(work_, airy_);
   laplacian(airy_, lap_);
   return hx_ * hy_ / (2.0 * physics_.young * physics_.thickness) * lap_.squaredNorm();  // (81)
@@ -165,8 +164,8 @@ double VonKarmanPlate::splitPotential(const Vector& q) const { return airyAndPot
 
 double VonKarmanPlate::splitGradient(const Vector& q, Vector& grad) const {
   const double v = airyAndPotential(q);
-  bracket(q, airy_, grad);
-  grad *= -hx_ * hy_;  // ∇V' = −hx hy ℓ(q, F)
+  bordered(q, airy_);
+  unpad(paddedOut_, -hx_ * hy_, grad);  // ∇V' = −hx hy ℓ(q, F)
   return v;
 }
 
