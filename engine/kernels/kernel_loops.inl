@@ -3,6 +3,8 @@
 // HAMILTONE_KERNEL_LANES (the doubles in one of its vector registers). Everything
 // here has internal linkage or that namespace's name, so no inline function compiled for one
 // instruction set can be taken by the linker for another.
+#include <algorithm>
+
 namespace hamiltone::HAMILTONE_KERNEL_NS {
 namespace {
 
@@ -160,38 +162,30 @@ constexpr int kLanes = HAMILTONE_KERNEL_LANES;
 typedef double Lanes __attribute__((vector_size(kLanes * sizeof(double))));
 
 HAMILTONE_TARGET void matrixProduct(const double* a, long lda, const double* b, long ldb,
-                                    double* c, long ldc, long m, long k, long n) {
-  // One register of rows × four columns of C held in registers while p runs.
-  long j = 0;
-  for (; j + 4 <= n; j += 4) {
-    const double* bj = b + ldb * j;
+                                    long stepB, double* c, long ldc, long m, long k, long n) {
+  // One register of rows × four columns of C held in registers while p runs; the last block's
+  // missing columns repeat its last one, and are not stored.
+  for (long j = 0; j < n; j += 4) {
+    const double* b0 = b + ldb * j;
+    const double* b1 = b + ldb * std::min(j + 1, n - 1);
+    const double* b2 = b + ldb * std::min(j + 2, n - 1);
+    const double* b3 = b + ldb * std::min(j + 3, n - 1);
+    const long columns = std::min(4L, n - j);
     for (long i = 0; i < m; i += kLanes) {
       Lanes c0 = {}, c1 = {}, c2 = {}, c3 = {};
       for (long p = 0; p < k; ++p) {
         Lanes ap;
         __builtin_memcpy(&ap, a + i + lda * p, sizeof ap);
-        c0 += ap * bj[p];
-        c1 += ap * bj[p + ldb];
-        c2 += ap * bj[p + 2 * ldb];
-        c3 += ap * bj[p + 3 * ldb];
+        c0 += ap * b0[stepB * p];
+        c1 += ap * b1[stepB * p];
+        c2 += ap * b2[stepB * p];
+        c3 += ap * b3[stepB * p];
       }
-      double* cj = c + i + ldc * j;
-      __builtin_memcpy(cj, &c0, sizeof c0);
-      __builtin_memcpy(cj + ldc, &c1, sizeof c1);
-      __builtin_memcpy(cj + 2 * ldc, &c2, sizeof c2);
-      __builtin_memcpy(cj + 3 * ldc, &c3, sizeof c3);
+      const Lanes* block[4] = {&c0, &c1, &c2, &c3};
+      for (long t = 0; t < columns; ++t)
+        __builtin_memcpy(c + i + ldc * (j + t), block[t], sizeof(Lanes));
     }
   }
-  for (; j < n; ++j)
-    for (long i = 0; i < m; i += kLanes) {
-      Lanes c0 = {};
-      for (long p = 0; p < k; ++p) {
-        Lanes ap;
-        __builtin_memcpy(&ap, a + i + lda * p, sizeof ap);
-        c0 += ap * b[p + ldb * j];
-      }
-      __builtin_memcpy(c + i + ldc * j, &c0, sizeof c0);
-    }
 }
 
 // The grid loops run over whole padded rows as one loop (rows of 30 do not vectorise well) and

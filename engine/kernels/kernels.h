@@ -45,10 +45,11 @@ struct Kernels {
                       const double* minv, const double* kq, const double* x, double xScale,
                       double down, double kk, double c, double invUp, double* qp);
 
-  // The plate's loops. C = A B, column-major, A m × k (leading dimension lda), B k × n, C m × n;
-  // m a multiple of 8. Each c_ij is Σ_p a_ip b_pj summed in order of p: the same bits on every path.
-  void (*matrixProduct)(const double* a, long lda, const double* b, long ldb, double* c, long ldc,
-                        long m, long k, long n);
+  // The plate's loops. C = A B, column-major, A m × k (leading dimension lda), B k × n read as
+  // b_pj = b[stepB p + ldb j], C m × n; m a multiple of 8. Each c_ij is Σ_p a_ip b_pj summed in
+  // order of p: the same bits on every path.
+  void (*matrixProduct)(const double* a, long lda, const double* b, long ldb, long stepB,
+                        double* c, long ldc, long m, long k, long n);
   // On zero-bordered grids — ny rows of px = nx + 2 values between a zero row above and below,
   // the first and last value of a row zero — out = cx D_xx f + cy D_yy f, its border zero again.
   void (*gridLaplacian)(const double* f, long px, long ny, double cx, double cy, double* out);

@@ -2,7 +2,6 @@
 // on the kernels' loops.
 #include "models/plate.h"
 
-#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -53,9 +52,25 @@ VonKarmanPlate::VonKarmanPlate(const PlatePhysics& p, int segmentsX, int segment
   inverseMass_ = Vector::Constant(n, 1.0 / (p.density * p.thickness * hx_ * hy_));
   px_ = nx_ + 2;
   rows_ = (nx_ + 7) / 8 * 8;
-  sx_.setZero(rows_, nx_);
-  sx_.topRows(nx_) = dst1(nx_);
-  sy_ = dst1(ny_);
+  const int halfX = (nx_ + 1) / 2, halfY = (ny_ + 1) / 2;
+  halfRows_ = (halfX + 7) / 8 * 8;
+  const Eigen::MatrixXd sx = dst1(nx_), sy = dst1(ny_);
+  sxEven_.setZero(halfRows_, (nx_ + 1) / 2);
+  sxOdd_.setZero(halfRows_, nx_ / 2);
+  for (int a = 0; a < halfX; ++a) {
+    for (int e = 0; e < sxEven_.cols(); ++e) sxEven_(a, e) = sx(a, 2 * e);
+    for (int o = 0; o < sxOdd_.cols(); ++o) sxOdd_(a, o) = sx(a, 2 * o + 1);
+  }
+  syEven_.setZero((ny_ + 1) / 2, halfY);
+  syOdd_.setZero(ny_ / 2, halfY);
+  for (int j = 0; j < halfY; ++j) {
+    for (int e = 0; e < syEven_.rows(); ++e) syEven_(e, j) = sy(2 * e, j);
+    for (int o = 0; o < syOdd_.rows(); ++o) syOdd_(o, j) = sy(2 * o + 1, j);
+  }
+  evenX_.setZero(halfRows_, ny_);
+  oddX_.setZero(halfRows_, ny_);
+  evenY_.setZero(rows_, halfY);
+  oddY_.setZero(rows_, halfY);
   inverseSquared_.setZero(rows_, ny_);
   for (int i = 0; i < nx_; ++i)
     for (int j = 0; j < ny_; ++j)
@@ -81,8 +96,11 @@ double VonKarmanPlate::stiffnessEigenvalueMax() const {
 }
 
 void VonKarmanPlate::pad(const double* v, Vector& padded) const {
-  for (int m = 0; m < ny_; ++m)
-    std::copy_n(v + static_cast<Eigen::Index>(nx_) * m, nx_, padded.data() + 1 + px_ * (m + 1));
+  for (int m = 0; m < ny_; ++m) {
+    const double* row = v + static_cast<Eigen::Index>(nx_) * m;
+    double* p = padded.data() + 1 + px_ * (m + 1);
+    for (int l = 0; l < nx_; ++l) p[l] = row[l];  // rows of ~30: a call to memmove costs more
+  }
 }
 
 void VonKarmanPlate::unpad(const Vector& padded, double scale, Vector& out) const {
@@ -114,49 +132,70 @@ void VonKarmanPlate::applyLossOperator(const Vector& a, const Vector& b, Vector&
   out *= -physics_.density * physics_.thickness * hx_ * hy_;
 }
 
+void VonKarmanPlate::transformX(const double* r, long ld) const {
+  const int high = nx_ / 2;  // rows nx − 1 down to ⌈nx/2⌉: from the half products' first ones
+  kernels_->matrixProduct(sxEven_.data(), halfRows_, r, ld, 2, evenX_.data(), halfRows_,
+                          halfRows_, sxEven_.cols(), ny_);
+  kernels_->matrixProduct(sxOdd_.data(), halfRows_, r + 1, ld, 2, oddX_.data(), halfRows_,
+                          halfRows_, sxOdd_.cols(), ny_);
+  for (int j = 0; j < ny_; ++j) {
+    const double* e = evenX_.col(j).data();
+    const double* o = oddX_.col(j).data();
+    double* h = half_.col(j).data();
+    for (int a = 0; a < (nx_ + 1) / 2; ++a) h[a] = e[a] + o[a];
+    for (int a = 0; a < high; ++a) h[nx_ - 1 - a] = e[a] - o[a];
+  }
+}
+
+void VonKarmanPlate::transformY() const {
+  const int low = (ny_ + 1) / 2, high = ny_ / 2;
+  kernels_->matrixProduct(half_.data(), 2 * rows_, syEven_.data(), syEven_.rows(), 1,
+                          evenY_.data(), rows_, rows_, syEven_.rows(), low);
+  kernels_->matrixProduct(half_.data() + rows_, 2 * rows_, syOdd_.data(), syOdd_.rows(), 1,
+                          oddY_.data(), rows_, rows_, syOdd_.rows(), low);
+  for (int j = 0; j < low; ++j) spectral_.col(j) = evenY_.col(j) + oddY_.col(j);
+  for (int j = 0; j < high; ++j) spectral_.col(ny_ - 1 - j) = evenY_.col(j) - oddY_.col(j);
+}
+
 void VonKarmanPlate::solveBiharmonic(const Vector& rhs, Vector& f) const {
-  // S_x R S_y, scaled by 1/λ², and back: four products of rows_ (a multiple of 8) rows.
-  const long rows = rows_, nx = nx_, ny = ny_;
-  kernels_->matrixProduct(sx_.data(), rows, rhs.data(), nx, half_.data(), rows, rows, nx, ny);
-  kernels_->matrixProduct(half_.data(), rows, sy_.data(), ny, spectral_.data(), rows, rows, ny, ny);
-  spectral_.array() *= inverseSquared_.array();
-  kernels_->matrixProduct(sx_.data(), rows, spectral_.data(), rows, half_.data(), rows, rows, nx,
-                          ny);
-  kernels_->matrixProduct(half_.data(), rows, sy_.data(), ny, spectral_.data(), rows, rows, ny, ny);
+  transformX(rhs.data(), nx_);  // R̂ = S_x R S_y
+  transformY();
+  spectral_.array() *= inverseSquared_.array();  // F̂ = R̂ / λ²
+  transformX(spectral_.data(), rows_);  // F = S_x F̂ S_y
+  transformY();
   Eigen::Map<Eigen::MatrixXd>(f.data(), nx_, ny_) = spectral_.topRows(nx_);
 }
 
 // ℓ(f, g) of (78), on bordered copies: each mixed difference at a point is a cell difference of one
 // of the four cells around it, so the cells are computed once per grid and the point loop has no
-// branch.
-void VonKarmanPlate::bordered(const Vector& f, const Vector& g) const {
-  pad(f.data(), paddedQ_);
+// branch. The state's copy and cells (paddedQ_, cellsQ_) serve both brackets of a gradient.
+void VonKarmanPlate::padState(const Vector& q) const {
+  pad(q.data(), paddedQ_);
   kernels_->gridCells(paddedQ_.data(), px_, ny_, cellsQ_.data());
-  const Vector* gp = &paddedQ_;
-  const Vector* gc = &cellsQ_;
-  if (&g != &f) {
-    pad(g.data(), paddedF_);
-    kernels_->gridCells(paddedF_.data(), px_, ny_, cellsF_.data());
-    gp = &paddedF_;
-    gc = &cellsF_;
-  }
+}
+
+void VonKarmanPlate::bracketOfState(const Vector& padded, const Vector& cells) const {
   const double ix2 = 1.0 / (hx_ * hx_), iy2 = 1.0 / (hy_ * hy_),
                ixy2 = 1.0 / (hx_ * hy_ * hx_ * hy_);
-  kernels_->gridBracket(paddedQ_.data(), gp->data(), cellsQ_.data(), gc->data(), px_, ny_, ix2,
-                        iy2, ixy2, paddedOut_.data());
+  kernels_->gridBracket(paddedQ_.data(), padded.data(), cellsQ_.data(), cells.data(), px_, ny_,
+                        ix2, iy2, ixy2, paddedOut_.data());
 }
 
 void VonKarmanPlate::bracket(const Vector& f, const Vector& g, Vector& out) const {
-  bordered(f, g);
+  padState(f);
+  pad(g.data(), paddedF_);
+  kernels_->gridCells(paddedF_.data(), px_, ny_, cellsF_.data());
+  bracketOfState(paddedF_, cellsF_);
   unpad(paddedOut_, 1.0, out);
 }
 
 double VonKarmanPlate::airyAndPotential(const Vector& q) const {
-  bordered(q, q);
+  padState(q);
+  bracketOfState(paddedQ_, cellsQ_);
   // DΔΔ F = −(Eξ/2) ℓ(q, q)   (79)
   unpad(paddedOut_, -0.5 * physics_.young * physics_.thickness, work_);
   solveBiharmonic(work_, airy_);
-  laplacian(airy_, lap_);
+  laplacian(airy_, lap_);  // leaves F's bordered copy in paddedF_
   return hx_ * hy_ / (2.0 * physics_.young * physics_.thickness) * lap_.squaredNorm();  // (81)
 }
 
@@ -164,7 +203,8 @@ double VonKarmanPlate::splitPotential(const Vector& q) const { return airyAndPot
 
 double VonKarmanPlate::splitGradient(const Vector& q, Vector& grad) const {
   const double v = airyAndPotential(q);
-  bordered(q, airy_);
+  kernels_->gridCells(paddedF_.data(), px_, ny_, cellsF_.data());
+  bracketOfState(paddedF_, cellsF_);
   unpad(paddedOut_, -hx_ * hy_, grad);  // ∇V' = −hx hy ℓ(q, F)
   return v;
 }
