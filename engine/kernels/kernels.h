@@ -1,8 +1,8 @@
-// The hot loops of the string and plate voices, compiled for several instruction sets and chosen once per
-// process (when the first string or scheme is built) from what the CPU reports: plain x86-64
-// (SSE2), x86-64-v3 (AVX2 + FMA) and x86-64-v4 (AVX-512). The same path on the same CPU gives the
-// same bits run to run; two paths differ in the order of their sums (the vector width), by
-// roundoff.
+// The hot loops of the string and plate voices, compiled for several instruction sets and chosen
+// once per process (when the first string or scheme is built) from what the CPU reports: plain
+// x86-64 (SSE2), x86-64-v3 (AVX2 + FMA) and x86-64-v4 (AVX-512). The same path on the same CPU
+// gives the same bits run to run; two paths differ in the order of their sums (the vector width),
+// by roundoff.
 #pragma once
 
 #include <string>
@@ -48,8 +48,8 @@ struct Kernels {
   // The plate's loops. C = A B, column-major, A m × k (leading dimension lda), B k × n read as
   // b_pj = b[stepB p + ldb j], C m × n; m a multiple of 8. Each c_ij is Σ_p a_ip b_pj summed in
   // order of p: the same bits on every path.
-  void (*matrixProduct)(const double* a, long lda, const double* b, long ldb, long stepB,
-                        double* c, long ldc, long m, long k, long n);
+  void (*matrixProduct)(const double* a, long lda, const double* b, long ldb, long stepB, double* c,
+                        long ldc, long m, long k, long n);
   // On zero-bordered grids — ny rows of px = nx + 2 values between a zero row above and below,
   // the first and last value of a row zero — out = cx D_xx f + cy D_yy f, its border zero again.
   void (*gridLaplacian)(const double* f, long px, long ny, double cx, double cy, double* out);

@@ -134,8 +134,8 @@ void VonKarmanPlate::applyLossOperator(const Vector& a, const Vector& b, Vector&
 
 void VonKarmanPlate::transformX(const double* r, long ld) const {
   const int high = nx_ / 2;  // rows nx − 1 down to ⌈nx/2⌉: from the half products' first ones
-  kernels_->matrixProduct(sxEven_.data(), halfRows_, r, ld, 2, evenX_.data(), halfRows_,
-                          halfRows_, sxEven_.cols(), ny_);
+  kernels_->matrixProduct(sxEven_.data(), halfRows_, r, ld, 2, evenX_.data(), halfRows_, halfRows_,
+                          sxEven_.cols(), ny_);
   kernels_->matrixProduct(sxOdd_.data(), halfRows_, r + 1, ld, 2, oddX_.data(), halfRows_,
                           halfRows_, sxOdd_.cols(), ny_);
   for (int j = 0; j < ny_; ++j) {
@@ -149,8 +149,8 @@ void VonKarmanPlate::transformX(const double* r, long ld) const {
 
 void VonKarmanPlate::transformY() const {
   const int low = (ny_ + 1) / 2, high = ny_ / 2;
-  kernels_->matrixProduct(half_.data(), 2 * rows_, syEven_.data(), syEven_.rows(), 1,
-                          evenY_.data(), rows_, rows_, syEven_.rows(), low);
+  kernels_->matrixProduct(half_.data(), 2 * rows_, syEven_.data(), syEven_.rows(), 1, evenY_.data(),
+                          rows_, rows_, syEven_.rows(), low);
   kernels_->matrixProduct(half_.data() + rows_, 2 * rows_, syOdd_.data(), syOdd_.rows(), 1,
                           oddY_.data(), rows_, rows_, syOdd_.rows(), low);
   for (int j = 0; j < low; ++j) spectral_.col(j) = evenY_.col(j) + oddY_.col(j);
@@ -161,7 +161,7 @@ void VonKarmanPlate::solveBiharmonic(const Vector& rhs, Vector& f) const {
   transformX(rhs.data(), nx_);  // R̂ = S_x R S_y
   transformY();
   spectral_.array() *= inverseSquared_.array();  // F̂ = R̂ / λ²
-  transformX(spectral_.data(), rows_);  // F = S_x F̂ S_y
+  transformX(spectral_.data(), rows_);           // F = S_x F̂ S_y
   transformY();
   Eigen::Map<Eigen::MatrixXd>(f.data(), nx_, ny_) = spectral_.topRows(nx_);
 }
@@ -177,8 +177,8 @@ void VonKarmanPlate::padState(const Vector& q) const {
 void VonKarmanPlate::bracketOfState(const Vector& padded, const Vector& cells) const {
   const double ix2 = 1.0 / (hx_ * hx_), iy2 = 1.0 / (hy_ * hy_),
                ixy2 = 1.0 / (hx_ * hy_ * hx_ * hy_);
-  kernels_->gridBracket(paddedQ_.data(), padded.data(), cellsQ_.data(), cells.data(), px_, ny_,
-                        ix2, iy2, ixy2, paddedOut_.data());
+  kernels_->gridBracket(paddedQ_.data(), padded.data(), cellsQ_.data(), cells.data(), px_, ny_, ix2,
+                        iy2, ixy2, paddedOut_.data());
 }
 
 void VonKarmanPlate::bracket(const Vector& f, const Vector& g, Vector& out) const {

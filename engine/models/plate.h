@@ -60,24 +60,24 @@ class VonKarmanPlate {
   // The Airy stress function of a state (the last one a potential or gradient computed).
   const Vector& airy() const { return airy_; }
 
- void setKernels(const Kernels& kernels) noexcept { kernels_ = &kernels; }
+  void setKernels(const Kernels& kernels) noexcept { kernels_ = &kernels; }
 
  private:
-  double airyAndPotential(const Vector& q) const;  // fills airy_, returns V'
+  double airyAndPotential(const Vector& q) const;   // fills airy_, returns V'
   void pad(const double* v, Vector& padded) const;  // v's nx × ny values inside the zero border
   // out = scale × the interior of a bordered grid
   void unpad(const Vector& padded, double scale, Vector& out) const;
   void transformX(const double* r, long ld) const;  // S_x R (R nx × ny) into half_
-  void transformY() const;                           // half_ S_y into spectral_
-  void padState(const Vector& q) const;  // q's bordered copy and cells
+  void transformY() const;                          // half_ S_y into spectral_
+  void padState(const Vector& q) const;             // q's bordered copy and cells
   // ℓ(q, g) into paddedOut_, g given by its bordered copy and cells
   void bracketOfState(const Vector& padded, const Vector& cells) const;
 
   PlatePhysics physics_;
   int nx_, ny_;
-  long px_;    // a bordered row: nx + 2 values
-  long rows_;       // the transforms' leading dimension: nx rounded up to a multiple of 8
-  long halfRows_;   // ⌈nx/2⌉ rounded up likewise
+  long px_;        // a bordered row: nx + 2 values
+  long rows_;      // the transforms' leading dimension: nx rounded up to a multiple of 8
+  long halfRows_;  // ⌈nx/2⌉ rounded up likewise
   double hx_, hy_;
   Vector inverseMass_;
   // The orthonormal DST-I S (symmetric, its own inverse) by the parity of its rows and columns:
