@@ -1,4 +1,5 @@
-// The plate's stencils (DΔ, ℓ of (78)), the exact Airy solve by dense 2-D DST-I, and V', ∇V' (81).
+// The plate's stencils (DΔ, ℓ of (78)), the exact Airy solve by dense 2-D DST-I, and V', ∇V' (81),
+// on the kernels' loops.
 #include "instruments/plate.h"
 
 #include <cmath>
@@ -49,21 +50,38 @@ VonKarmanPlate::VonKarmanPlate(const PlatePhysics& p, int segmentsX, int segment
   hy_ = p.ly / segmentsY;
   const Eigen::Index n = static_cast<Eigen::Index>(nx_) * ny_;
   inverseMass_ = Vector::Constant(n, 1.0 / (p.density * p.thickness * hx_ * hy_));
-  sx_ = dst1(nx_);
-  sy_ = dst1(ny_);
-  inverseSquared_.resize(nx_, ny_);
+  px_ = nx_ + 2;
+  rows_ = (nx_ + 7) / 8 * 8;
+  const int halfX = (nx_ + 1) / 2, halfY = (ny_ + 1) / 2;
+  halfRows_ = (halfX + 7) / 8 * 8;
+  const Eigen::MatrixXd sx = dst1(nx_), sy = dst1(ny_);
+  sxEven_.setZero(halfRows_, (nx_ + 1) / 2);
+  sxOdd_.setZero(halfRows_, nx_ / 2);
+  for (int a = 0; a < halfX; ++a) {
+    for (int e = 0; e < sxEven_.cols(); ++e) sxEven_(a, e) = sx(a, 2 * e);
+    for (int o = 0; o < sxOdd_.cols(); ++o) sxOdd_(a, o) = sx(a, 2 * o + 1);
+  }
+  syEven_.setZero((ny_ + 1) / 2, halfY);
+  syOdd_.setZero(ny_ / 2, halfY);
+  for (int j = 0; j < halfY; ++j) {
+    for (int e = 0; e < syEven_.rows(); ++e) syEven_(e, j) = sy(2 * e, j);
+    for (int o = 0; o < syOdd_.rows(); ++o) syOdd_(o, j) = sy(2 * o + 1, j);
+  }
+  evenX_.setZero(halfRows_, ny_);
+  oddX_.setZero(halfRows_, ny_);
+  evenY_.setZero(rows_, halfY);
+  oddY_.setZero(rows_, halfY);
+  inverseSquared_.setZero(rows_, ny_);
   for (int i = 0; i < nx_; ++i)
     for (int j = 0; j < ny_; ++j)
       inverseSquared_(i, j) = 1.0 / std::pow(laplacianEigenvalue(i + 1, j + 1), 2);
   airy_.setZero(n);
   work_.setZero(n);
   lap_.setZero(n);
-  spectral_.setZero(nx_, ny_);
-  half_.setZero(nx_, ny_);
-  padF_.setZero(static_cast<Eigen::Index>(nx_ + 2) * (ny_ + 2));
-  padG_.setZero(padF_.size());
-  cellF_.setZero(static_cast<Eigen::Index>(nx_ + 1) * (ny_ + 1));
-  cellG_.setZero(cellF_.size());
+  spectral_.setZero(rows_, ny_);
+  half_.setZero(rows_, ny_);
+  const Eigen::Index bordered = px_ * (ny_ + 2);
+  for (Vector* v : {&paddedQ_, &cellsQ_, &paddedF_, &cellsF_, &paddedOut_}) v->setZero(bordered);
 }
 
 double VonKarmanPlate::laplacianEigenvalue(int i, int j) const {
@@ -77,22 +95,35 @@ double VonKarmanPlate::stiffnessEigenvalueMax() const {
   return d * std::pow(laplacianEigenvalue(nx_, ny_), 2);
 }
 
+void VonKarmanPlate::pad(const double* v, Vector& padded) const {
+  for (int m = 0; m < ny_; ++m) {
+    const double* row = v + static_cast<Eigen::Index>(nx_) * m;
+    double* p = padded.data() + 1 + px_ * (m + 1);
+    for (int l = 0; l < nx_; ++l) p[l] = row[l];  // rows of ~30: a call to memmove costs more
+  }
+}
+
+void VonKarmanPlate::unpad(const Vector& padded, double scale, Vector& out) const {
+  for (int m = 0; m < ny_; ++m) {
+    const double* row = padded.data() + 1 + px_ * (m + 1);
+    double* o = out.data() + static_cast<Eigen::Index>(nx_) * m;
+    for (int l = 0; l < nx_; ++l) o[l] = row[l] * scale;
+  }
+}
+
 void VonKarmanPlate::laplacian(const Vector& f, Vector& out) const {
-  const double cx = 1.0 / (hx_ * hx_), cy = 1.0 / (hy_ * hy_);
-  for (int m = 0; m < ny_; ++m)
-    for (int l = 0; l < nx_; ++l) {
-      const Eigen::Index i = l + static_cast<Eigen::Index>(nx_) * m;
-      const double c = f[i];
-      const double w = l > 0 ? f[i - 1] : 0.0, e = l + 1 < nx_ ? f[i + 1] : 0.0;
-      const double s = m > 0 ? f[i - nx_] : 0.0, nn = m + 1 < ny_ ? f[i + nx_] : 0.0;
-      out[i] = cx * (w - 2.0 * c + e) + cy * (s - 2.0 * c + nn);
-    }
+  pad(f.data(), paddedF_);
+  kernels_->gridLaplacian(paddedF_.data(), px_, ny_, 1.0 / (hx_ * hx_), 1.0 / (hy_ * hy_),
+                          paddedOut_.data());
+  unpad(paddedOut_, 1.0, out);
 }
 
 void VonKarmanPlate::applyStiffness(const Vector& q, Vector& out) const {
-  laplacian(q, lap_);
-  laplacian(lap_, out);
-  out *= physics_.rigidity() * hx_ * hy_;
+  const double cx = 1.0 / (hx_ * hx_), cy = 1.0 / (hy_ * hy_);
+  pad(q.data(), paddedF_);
+  kernels_->gridLaplacian(paddedF_.data(), px_, ny_, cx, cy, paddedOut_.data());
+  kernels_->gridLaplacian(paddedOut_.data(), px_, ny_, cx, cy, paddedF_.data());
+  unpad(paddedF_, physics_.rigidity() * hx_ * hy_, out);
 }
 
 void VonKarmanPlate::applyLossOperator(const Vector& a, const Vector& b, Vector& out) const {
@@ -101,63 +132,70 @@ void VonKarmanPlate::applyLossOperator(const Vector& a, const Vector& b, Vector&
   out *= -physics_.density * physics_.thickness * hx_ * hy_;
 }
 
-void VonKarmanPlate::solveBiharmonic(const Vector& rhs, Vector& f) const {
-  const Eigen::Map<const Eigen::MatrixXd> r(rhs.data(), nx_, ny_);
-  Eigen::Map<Eigen::MatrixXd> out(f.data(), nx_, ny_);
-  // Eigen's blocked products: at 30 × 30 twice as fast as coefficient-wise ones; their blocking
-  // buffers live on the stack at these sizes (the no-allocation test covers the plate).
-  half_.noalias() = sx_ * r;
-  spectral_.noalias() = half_ * sy_;
-  spectral_.array() *= inverseSquared_.array();
-  half_.noalias() = sx_ * spectral_;
-  out.noalias() = half_ * sy_;
-}
-
-// (78): ℓ(f,g) = D_xx f D_yy g + D_yy f D_xx g − ½ Σ_± D_{x±}D_{y±} f · D_{x±}D_{y±} g. On arrays
-// padded with the zero boundary, each mixed difference at a point is a cell difference
-// c(l, m) = f(l+1, m+1) − f(l+1, m) − f(l, m+1) + f(l, m) of one of the four cells around it, so
-// both are computed once per array and the point loop has no branch.
-void VonKarmanPlate::bracket(const Vector& f, const Vector& g, Vector& out) const {
-  const int px = nx_ + 2;  // padded row length
-  const int cx = nx_ + 1;  // cells per row
-  auto pad = [&](const Vector& v, Vector& padded, Vector& cells) {
-    for (int m = 0; m < ny_; ++m)
-      for (int l = 0; l < nx_; ++l) padded[(l + 1) + px * (m + 1)] = v[l + nx_ * m];
-    for (int m = 0; m <= ny_; ++m)
-      for (int l = 0; l <= nx_; ++l) {
-        const double* p = padded.data() + l + px * m;
-        cells[l + cx * m] = p[px + 1] - p[1] - p[px] + p[0];
-      }
-  };
-  pad(f, padF_, cellF_);
-  pad(g, padG_, cellG_);
-  const double ix2 = 1.0 / (hx_ * hx_), iy2 = 1.0 / (hy_ * hy_),
-               ixy2 = 1.0 / (hx_ * hy_ * hx_ * hy_);
-  for (int m = 0; m < ny_; ++m) {
-    const double* fp = padF_.data() + 1 + px * (m + 1);  // the point (l, m) at fp[l]
-    const double* gp = padG_.data() + 1 + px * (m + 1);
-    const double* fc = cellF_.data() + cx * m;  // cells (l−1 … l, m−1 … m) at fc[l], fc[l+1], …
-    const double* gc = cellG_.data() + cx * m;
-    double* o = out.data() + nx_ * m;
-#pragma omp simd
-    for (int l = 0; l < nx_; ++l) {
-      const double fxx = (fp[l - 1] - 2.0 * fp[l] + fp[l + 1]) * ix2;
-      const double fyy = (fp[l - px] - 2.0 * fp[l] + fp[l + px]) * iy2;
-      const double gxx = (gp[l - 1] - 2.0 * gp[l] + gp[l + 1]) * ix2;
-      const double gyy = (gp[l - px] - 2.0 * gp[l] + gp[l + px]) * iy2;
-      // cells around point (l, m): (l−1, m−1) … (l, m), i.e. fc[l], fc[l+1], fc[l+cx], fc[l+1+cx]
-      const double cross = fc[l] * gc[l] + fc[l + 1] * gc[l + 1] + fc[l + cx] * gc[l + cx] +
-                           fc[l + 1 + cx] * gc[l + 1 + cx];
-      o[l] = fxx * gyy + fyy * gxx - 0.5 * cross * ixy2;
-    }
+void VonKarmanPlate::transformX(const double* r, long ld) const {
+  const int high = nx_ / 2;  // rows nx − 1 down to ⌈nx/2⌉: from the half products' first ones
+  kernels_->matrixProduct(sxEven_.data(), halfRows_, r, ld, 2, evenX_.data(), halfRows_, halfRows_,
+                          sxEven_.cols(), ny_);
+  kernels_->matrixProduct(sxOdd_.data(), halfRows_, r + 1, ld, 2, oddX_.data(), halfRows_,
+                          halfRows_, sxOdd_.cols(), ny_);
+  for (int j = 0; j < ny_; ++j) {
+    const double* e = evenX_.col(j).data();
+    const double* o = oddX_.col(j).data();
+    double* h = half_.col(j).data();
+    for (int a = 0; a < (nx_ + 1) / 2; ++a) h[a] = e[a] + o[a];
+    for (int a = 0; a < high; ++a) h[nx_ - 1 - a] = e[a] - o[a];
   }
 }
 
+void VonKarmanPlate::transformY() const {
+  const int low = (ny_ + 1) / 2, high = ny_ / 2;
+  kernels_->matrixProduct(half_.data(), 2 * rows_, syEven_.data(), syEven_.rows(), 1, evenY_.data(),
+                          rows_, rows_, syEven_.rows(), low);
+  kernels_->matrixProduct(half_.data() + rows_, 2 * rows_, syOdd_.data(), syOdd_.rows(), 1,
+                          oddY_.data(), rows_, rows_, syOdd_.rows(), low);
+  for (int j = 0; j < low; ++j) spectral_.col(j) = evenY_.col(j) + oddY_.col(j);
+  for (int j = 0; j < high; ++j) spectral_.col(ny_ - 1 - j) = evenY_.col(j) - oddY_.col(j);
+}
+
+void VonKarmanPlate::solveBiharmonic(const Vector& rhs, Vector& f) const {
+  transformX(rhs.data(), nx_);  // R̂ = S_x R S_y
+  transformY();
+  spectral_.array() *= inverseSquared_.array();  // F̂ = R̂ / λ²
+  transformX(spectral_.data(), rows_);           // F = S_x F̂ S_y
+  transformY();
+  Eigen::Map<Eigen::MatrixXd>(f.data(), nx_, ny_) = spectral_.topRows(nx_);
+}
+
+// ℓ(f, g) of (78), on bordered copies: each mixed difference at a point is a cell difference of one
+// of the four cells around it, so the cells are computed once per grid and the point loop has no
+// branch. The state's copy and cells (paddedQ_, cellsQ_) serve both brackets of a gradient.
+void VonKarmanPlate::padState(const Vector& q) const {
+  pad(q.data(), paddedQ_);
+  kernels_->gridCells(paddedQ_.data(), px_, ny_, cellsQ_.data());
+}
+
+void VonKarmanPlate::bracketOfState(const Vector& padded, const Vector& cells) const {
+  const double ix2 = 1.0 / (hx_ * hx_), iy2 = 1.0 / (hy_ * hy_),
+               ixy2 = 1.0 / (hx_ * hy_ * hx_ * hy_);
+  kernels_->gridBracket(paddedQ_.data(), padded.data(), cellsQ_.data(), cells.data(), px_, ny_, ix2,
+                        iy2, ixy2, paddedOut_.data());
+}
+
+void VonKarmanPlate::bracket(const Vector& f, const Vector& g, Vector& out) const {
+  padState(f);
+  pad(g.data(), paddedF_);
+  kernels_->gridCells(paddedF_.data(), px_, ny_, cellsF_.data());
+  bracketOfState(paddedF_, cellsF_);
+  unpad(paddedOut_, 1.0, out);
+}
+
 double VonKarmanPlate::airyAndPotential(const Vector& q) const {
-  bracket(q, q, work_);
-  work_ *= -0.5 * physics_.young * physics_.thickness;  // DΔΔ F = −(Eξ/2) ℓ(q, q)   (79)
+  padState(q);
+  bracketOfState(paddedQ_, cellsQ_);
+  // DΔΔ F = −(Eξ/2) ℓ(q, q)   (79)
+  unpad(paddedOut_, -0.5 * physics_.young * physics_.thickness, work_);
   solveBiharmonic(work_, airy_);
-  laplacian(airy_, lap_);
+  laplacian(airy_, lap_);  // leaves F's bordered copy in paddedF_
   return hx_ * hy_ / (2.0 * physics_.young * physics_.thickness) * lap_.squaredNorm();  // (81)
 }
 
@@ -165,8 +203,9 @@ double VonKarmanPlate::splitPotential(const Vector& q) const { return airyAndPot
 
 double VonKarmanPlate::splitGradient(const Vector& q, Vector& grad) const {
   const double v = airyAndPotential(q);
-  bracket(q, airy_, grad);
-  grad *= -hx_ * hy_;  // ∇V' = −hx hy ℓ(q, F)
+  kernels_->gridCells(paddedF_.data(), px_, ny_, cellsF_.data());
+  bracketOfState(paddedF_, cellsF_);
+  unpad(paddedOut_, -hx_ * hy_, grad);  // ∇V' = −hx hy ℓ(q, F)
   return v;
 }
 

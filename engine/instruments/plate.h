@@ -4,6 +4,7 @@
 
 #include <Eigen/Dense>
 
+#include "kernels/kernels.h"
 #include "schemes/hamiltonian.h"
 
 namespace hamiltone {
@@ -23,7 +24,8 @@ struct PlatePhysics {
 // (l fastest). With D_xx, D_yy the second differences (zero beyond the edges), DΔ = D_xx + D_yy:
 //   M = ρξ hx hy I,   K = D hx hy DΔΔ,   V' = hx hy/(2Eξ) ‖DΔ F‖²,   ∇V' = −hx hy ℓ(q, F) (80)–(81)
 // with ℓ of (78), its last term read −½ D_{x−}D_{y−}f · D_{x−}D_{y−}g (SCHEMES §4). The Airy solve
-// is exact: DΔ is diagonalised by the 2-D DST-I, applied as dense matrices built here.
+// is exact: DΔ is diagonalised by the 2-D DST-I, applied as dense matrices built here. The loops
+// are the kernels' (kernels/kernels.h), on copies of the grids with a zero border.
 class VonKarmanPlate {
  public:
   static constexpr bool hasStiffness = true;
@@ -58,19 +60,40 @@ class VonKarmanPlate {
   // The Airy stress function of a state (the last one a potential or gradient computed).
   const Vector& airy() const { return airy_; }
 
+  void setKernels(const Kernels& kernels) noexcept { kernels_ = &kernels; }
+
  private:
-  double airyAndPotential(const Vector& q) const;  // fills airy_, returns V'
+  double airyAndPotential(const Vector& q) const;   // fills airy_, returns V'
+  void pad(const double* v, Vector& padded) const;  // v's nx × ny values inside the zero border
+  // out = scale × the interior of a bordered grid
+  void unpad(const Vector& padded, double scale, Vector& out) const;
+  void transformX(const double* r, long ld) const;  // S_x R (R nx × ny) into half_
+  void transformY() const;                          // half_ S_y into spectral_
+  void padState(const Vector& q) const;             // q's bordered copy and cells
+  // ℓ(q, g) into paddedOut_, g given by its bordered copy and cells
+  void bracketOfState(const Vector& padded, const Vector& cells) const;
 
   PlatePhysics physics_;
   int nx_, ny_;
+  long px_;        // a bordered row: nx + 2 values
+  long rows_;      // the transforms' leading dimension: nx rounded up to a multiple of 8
+  long halfRows_;  // ⌈nx/2⌉ rounded up likewise
   double hx_, hy_;
   Vector inverseMass_;
-  Eigen::MatrixXd sx_, sy_;         // orthonormal DST-I matrices (symmetric, their own inverse)
-  Eigen::MatrixXd inverseSquared_;  // 1 / λ_ij² of DΔΔ, nx × ny
+  // The orthonormal DST-I S (symmetric, its own inverse) by the parity of its rows and columns:
+  // S(n − 1 − a, b) = (−1)^b S(a, b), so the first ⌈n/2⌉ rows of a transform, from the even and
+  // the odd entries apart, give all n: half the products. sxEven_(a, e) = S_x(a, 2e) and
+  // sxOdd_(a, o) = S_x(a, 2o + 1), a < ⌈nx/2⌉ (halfRows_ rows); syEven_(e, j) = S_y(2e, j),
+  // syOdd_(o, j) = S_y(2o + 1, j), j < ⌈ny/2⌉.
+  Eigen::MatrixXd sxEven_, sxOdd_, syEven_, syOdd_;
+  Eigen::MatrixXd inverseSquared_;  // 1 / λ_ij² of DΔΔ, rows_ × ny (0 beyond nx)
   mutable Vector airy_, work_, lap_;
-  mutable Eigen::MatrixXd spectral_;  // nx × ny scratch of the transforms
-  mutable Eigen::MatrixXd half_;
-  mutable Vector padF_, padG_, cellF_, cellG_;  // the bracket's zero-padded arrays and cells
+  mutable Eigen::MatrixXd spectral_, half_;  // rows_ × ny scratch of the transforms
+  mutable Eigen::MatrixXd evenX_, oddX_;     // halfRows_ × ny: the half products along x
+  mutable Eigen::MatrixXd evenY_, oddY_;     // rows_ × ⌈ny/2⌉: along y
+  // The bordered grids (px × (ny + 2)): the state and its cells, another grid and its cells, out.
+  mutable Vector paddedQ_, cellsQ_, paddedF_, cellsF_, paddedOut_;
+  const Kernels* kernels_ = &selectedKernels();
 };
 
 // Initial condition (85): q = α ξ sin(πx/Lx) sin(πy/Ly).

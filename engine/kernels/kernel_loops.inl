@@ -1,7 +1,10 @@
 // The loops of kernels.h, included by one file per instruction set, each of which defines
-// HAMILTONE_TARGET (a function attribute) and HAMILTONE_KERNEL_NS (its namespace). Everything
+// HAMILTONE_TARGET (a function attribute), HAMILTONE_KERNEL_NS (its namespace) and
+// HAMILTONE_KERNEL_LANES (the doubles in one of its vector registers). Everything
 // here has internal linkage or that namespace's name, so no inline function compiled for one
 // instruction set can be taken by the linker for another.
+#include <algorithm>
+
 namespace hamiltone::HAMILTONE_KERNEL_NS {
 namespace {
 
@@ -153,6 +156,73 @@ HAMILTONE_TARGET double savUpdate(long n, const double* g, const double* q, cons
   return savUpdateOf<false, false>(n, g, q, qm, minv, kq, x, xScale, down, kk, c, invUp, qp);
 }
 
+// One vector register of doubles (GCC's vector extension, so that the product below is vectorised
+// along the rows as written, whatever the compiler's cost model).
+constexpr int kLanes = HAMILTONE_KERNEL_LANES;
+typedef double Lanes __attribute__((vector_size(kLanes * sizeof(double))));
+
+HAMILTONE_TARGET void matrixProduct(const double* a, long lda, const double* b, long ldb,
+                                    long stepB, double* c, long ldc, long m, long k, long n) {
+  // One register of rows × four columns of C held in registers while p runs; the last block's
+  // missing columns repeat its last one, and are not stored.
+  for (long j = 0; j < n; j += 4) {
+    const double* b0 = b + ldb * j;
+    const double* b1 = b + ldb * std::min(j + 1, n - 1);
+    const double* b2 = b + ldb * std::min(j + 2, n - 1);
+    const double* b3 = b + ldb * std::min(j + 3, n - 1);
+    const long columns = std::min(4L, n - j);
+    for (long i = 0; i < m; i += kLanes) {
+      Lanes c0 = {}, c1 = {}, c2 = {}, c3 = {};
+      for (long p = 0; p < k; ++p) {
+        Lanes ap;
+        __builtin_memcpy(&ap, a + i + lda * p, sizeof ap);
+        c0 += ap * b0[stepB * p];
+        c1 += ap * b1[stepB * p];
+        c2 += ap * b2[stepB * p];
+        c3 += ap * b3[stepB * p];
+      }
+      const Lanes* block[4] = {&c0, &c1, &c2, &c3};
+      for (long t = 0; t < columns; ++t)
+        __builtin_memcpy(c + i + ldc * (j + t), block[t], sizeof(Lanes));
+    }
+  }
+}
+
+// The grid loops run over whole padded rows as one loop (rows of 30 do not vectorise well) and
+// put the border back afterwards.
+HAMILTONE_TARGET void gridLaplacian(const double* f, long px, long ny, double cx, double cy,
+                                    double* out) {
+#pragma omp simd
+  for (long i = px; i < px * (ny + 1); ++i)
+    out[i] = cx * (f[i - 1] - 2.0 * f[i] + f[i + 1]) + cy * (f[i - px] - 2.0 * f[i] + f[i + px]);
+  for (long row = 1; row <= ny; ++row) out[px * row] = out[px * row + px - 1] = 0.0;
+}
+
+HAMILTONE_TARGET void gridCells(const double* f, long px, long ny, double* cells) {
+#pragma omp simd
+  for (long i = px + 1; i < px * (ny + 2); ++i)
+    cells[i] = f[i] - f[i - px] - f[i - 1] + f[i - px - 1];
+}
+
+HAMILTONE_TARGET void gridBracket(const double* f, const double* g, const double* cellsF,
+                                  const double* cellsG, long px, long ny, double ix2, double iy2,
+                                  double ixy2, double* out) {
+  const double* cf = cellsF;
+  const double* cg = cellsG;
+  // Point i's four cells have upper corners i, i + 1, i + px and i + px + 1.
+#pragma omp simd
+  for (long i = px + 1; i < px * (ny + 1) - 1; ++i) {
+    const double fxx = (f[i - 1] - 2.0 * f[i] + f[i + 1]) * ix2;
+    const double fyy = (f[i - px] - 2.0 * f[i] + f[i + px]) * iy2;
+    const double gxx = (g[i - 1] - 2.0 * g[i] + g[i + 1]) * ix2;
+    const double gyy = (g[i - px] - 2.0 * g[i] + g[i + px]) * iy2;
+    const double cross = cf[i] * cg[i] + cf[i + 1] * cg[i + 1] + cf[i + px] * cg[i + px] +
+                         cf[i + px + 1] * cg[i + px + 1];
+    out[i] = fxx * gyy + fyy * gxx - 0.5 * cross * ixy2;
+  }
+  for (long row = 1; row <= ny; ++row) out[px * row] = out[px * row + px - 1] = 0.0;
+}
+
 }  // namespace
 
 extern const Kernels kernels{.isa = HAMILTONE_KERNEL_ISA,
@@ -163,6 +233,10 @@ extern const Kernels kernels{.isa = HAMILTONE_KERNEL_ISA,
                              .secondDifference = secondDifference,
                              .secondDifferenceOfDifference = secondDifferenceOfDifference,
                              .savDots = savDots,
-                             .savUpdate = savUpdate};
+                             .savUpdate = savUpdate,
+                             .matrixProduct = matrixProduct,
+                             .gridLaplacian = gridLaplacian,
+                             .gridCells = gridCells,
+                             .gridBracket = gridBracket};
 
 }  // namespace hamiltone::HAMILTONE_KERNEL_NS

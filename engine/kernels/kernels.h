@@ -1,8 +1,8 @@
-// The hot loops of the string voices, compiled for several instruction sets and chosen once per
-// process (when the first string or scheme is built) from what the CPU reports: plain x86-64
-// (SSE2), x86-64-v3 (AVX2 + FMA) and x86-64-v4 (AVX-512). The same path on the same CPU gives the
-// same bits run to run; two paths differ in the order of their sums (the vector width), by
-// roundoff.
+// The hot loops of the string and plate voices, compiled for several instruction sets and chosen
+// once per process (when the first string or scheme is built) from what the CPU reports: plain
+// x86-64 (SSE2), x86-64-v3 (AVX2 + FMA) and x86-64-v4 (AVX-512). The same path on the same CPU
+// gives the same bits run to run; two paths differ in the order of their sums (the vector width),
+// by roundoff.
 #pragma once
 
 #include <string>
@@ -44,6 +44,22 @@ struct Kernels {
   double (*savUpdate)(long n, const double* g, const double* q, const double* qm,
                       const double* minv, const double* kq, const double* x, double xScale,
                       double down, double kk, double c, double invUp, double* qp);
+
+  // The plate's loops. C = A B, column-major, A m × k (leading dimension lda), B k × n read as
+  // b_pj = b[stepB p + ldb j], C m × n; m a multiple of 8. Each c_ij is Σ_p a_ip b_pj summed in
+  // order of p: the same bits on every path.
+  void (*matrixProduct)(const double* a, long lda, const double* b, long ldb, long stepB, double* c,
+                        long ldc, long m, long k, long n);
+  // On zero-bordered grids — ny rows of px = nx + 2 values between a zero row above and below,
+  // the first and last value of a row zero — out = cx D_xx f + cy D_yy f, its border zero again.
+  void (*gridLaplacian)(const double* f, long px, long ny, double cx, double cy, double* out);
+  // The mixed difference of each cell, at the index of its upper corner:
+  // cells_i = f_i − f_{i−px} − f_{i−1} + f_{i−px−1}, for i from px + 1 to px (ny + 2) − 1.
+  void (*gridCells)(const double* f, long px, long ny, double* cells);
+  // ℓ(f, g) of (78) into out, its border zero: at each interior point
+  // ix2 iy2 (δxx f δyy g + δyy f δxx g) − ½ ixy2 Σ of the four cells' products around it.
+  void (*gridBracket)(const double* f, const double* g, const double* cellsF, const double* cellsG,
+                      long px, long ny, double ix2, double iy2, double ixy2, double* out);
 };
 
 // The best path this CPU runs, or the one HAMILTONE_ISA names (portable, avx2, avx512): decided

@@ -6,5 +6,6 @@
 #define HAMILTONE_KERNEL_NS avx2
 #define HAMILTONE_KERNEL_ISA Isa::avx2
 #define HAMILTONE_KERNEL_NAME "avx2"
+#define HAMILTONE_KERNEL_LANES 4  // doubles in a vector register
 #include "kernels/kernel_loops.inl"
 #endif

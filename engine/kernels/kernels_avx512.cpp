@@ -10,5 +10,6 @@
 #define HAMILTONE_KERNEL_NS avx512
 #define HAMILTONE_KERNEL_ISA Isa::avx512
 #define HAMILTONE_KERNEL_NAME "avx512"
+#define HAMILTONE_KERNEL_LANES 8  // doubles in a vector register
 #include "kernels/kernel_loops.inl"
 #endif

@@ -5,4 +5,5 @@
 #define HAMILTONE_KERNEL_NS portable
 #define HAMILTONE_KERNEL_ISA Isa::portable
 #define HAMILTONE_KERNEL_NAME "portable"
+#define HAMILTONE_KERNEL_LANES 2  // doubles in a vector register
 #include "kernels/kernel_loops.inl"

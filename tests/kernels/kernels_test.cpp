@@ -1,7 +1,8 @@
-// The kernels of every instruction set this CPU runs against the portable ones: the stencils and
-// the stretches bit for bit (the same IEEE operations in the same order, without contraction),
-// the scheme's sums within their reordering bound, and a struck two-grid string on each path
-// conserving energy and staying within roundoff growth of the portable run.
+// The kernels of every instruction set this CPU runs against the portable ones: the stencils, the
+// stretches and the plate's products and grid loops bit for bit (the same IEEE operations in the
+// same order, without contraction), the scheme's sums within their reordering bound, and a struck
+// two-grid string on each path conserving energy and staying within roundoff growth of the
+// portable run.
 #include "kernels/kernels.h"
 
 #include <gtest/gtest.h>
@@ -79,6 +80,61 @@ TEST(Kernels, StencilsAndStretchesAreBitIdenticalOnEveryPath) {
 }
 
 // A sum of n products reordered differs by at most ~n ε Σ|terms| (each partial sum rounds once).
+// The plate's loops: a product is a sum in order of p on every path, so all of them give the bits
+// of the plain triple loop; the grid stencils are the same operations on every path.
+TEST(Kernels, PlateProductsAndStencilsAreBitIdenticalOnEveryPath) {
+  std::vector<const Kernels*> paths = otherPaths();
+  paths.push_back(&kernelsFor(Isa::portable));
+  for (const Kernels* path : paths) {
+    // A (16 × 7, rows padded past 13), B read with a row step of 2, n = 1 … 9 columns (the
+    // blocks of four and the partial last block).
+    const long m = 16, k = 7, lda = 16, ldb = 19, step = 2;
+    const std::vector<double> a = randomArray(lda * k, 1.0, 3), b = randomArray(ldb * 9, 1.0, 4);
+    for (long n = 1; n <= 9; ++n) {
+      std::vector<double> c(m * n, -1.0), expected(m * n);
+      path->matrixProduct(a.data(), lda, b.data(), ldb, step, c.data(), m, m, k, n);
+      for (long j = 0; j < n; ++j)
+        for (long i = 0; i < m; ++i) {
+          double sum = 0.0;
+          for (long p = 0; p < k; ++p) sum += a[i + lda * p] * b[step * p + ldb * j];
+          expected[i + m * j] = sum;
+        }
+      EXPECT_EQ(c, expected) << path->name << " n = " << n;
+    }
+    // Grids of 1 × 1 … 13 × 5 interior points inside a zero border.
+    const Kernels& base = kernelsFor(Isa::portable);
+    for (long nx : {1L, 2L, 13L})
+      for (long ny : {1L, 5L}) {
+        const long px = nx + 2, size = px * (ny + 2);
+        std::vector<double> f(size, 0.0), g(size, 0.0);
+        const std::vector<double> rf = randomArray(nx * ny, 1e-3, 5),
+                                  rg = randomArray(nx * ny, 1e3, 6);
+        for (long row = 0; row < ny; ++row)
+          for (long l = 0; l < nx; ++l) {
+            f[1 + l + px * (row + 1)] = rf[l + nx * row];
+            g[1 + l + px * (row + 1)] = rg[l + nx * row];
+          }
+        std::vector<double> x(size, 7.0), y(size, 7.0), cf(size), cg(size), cf2(size), cg2(size);
+        base.gridLaplacian(f.data(), px, ny, 3.0, 5.0, x.data());
+        path->gridLaplacian(f.data(), px, ny, 3.0, 5.0, y.data());
+        EXPECT_EQ(x, y) << path->name;
+        for (long row = 1; row <= ny; ++row)
+          EXPECT_TRUE(y[px * row] == 0.0 && y[px * row + px - 1] == 0.0)
+              << "border, " << path->name;
+        base.gridCells(f.data(), px, ny, cf.data());
+        base.gridCells(g.data(), px, ny, cg.data());
+        path->gridCells(f.data(), px, ny, cf2.data());
+        path->gridCells(g.data(), px, ny, cg2.data());
+        EXPECT_EQ(cf, cf2) << path->name;
+        base.gridBracket(f.data(), g.data(), cf.data(), cg.data(), px, ny, 3.0, 5.0, 15.0,
+                         x.data());
+        path->gridBracket(f.data(), g.data(), cf.data(), cg.data(), px, ny, 3.0, 5.0, 15.0,
+                          y.data());
+        EXPECT_EQ(x, y) << path->name;
+      }
+  }
+}
+
 TEST(Kernels, SchemeSumsAgreeWithinTheirReorderingBound) {
   const Kernels& base = kernelsFor(Isa::portable);
   const long n = 387;

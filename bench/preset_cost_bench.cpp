@@ -1,0 +1,103 @@
+// What each bundled preset costs: keys spread over its range struck together at velocity 90 and
+// held (struck again every half second, so none decays), on one thread at 48 kHz. The time per
+// key per sample of audio gives the keys one core sustains in real time — the README's table.
+#include <benchmark/benchmark.h>
+
+#include <cstdio>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "presets/preset_loader.h"
+#include "synth/synth.h"
+
+namespace hamiltone {
+namespace {
+
+constexpr double kSampleRate = 48000.0;
+constexpr int kBlockSize = 256;
+constexpr double kRestrikeS = 0.5;
+
+struct Bundled {
+  const char* name;
+  int everyNth;  // keys measured: lowest, lowest + n, … up to the highest
+};
+const Bundled kPresets[] = {{"grand-piano", 6}, {"paper-c3-string", 3}, {"steel-plate", 3},
+                            {"gong", 3},        {"thunder-sheet", 2},   {"small-cymbal", 3}};
+
+void presetCost(benchmark::State& state) {
+  const Bundled& preset = kPresets[state.range(0)];
+  Instrument instrument =
+      loadPreset(std::string(HAMILTONE_SOURCE_DIR "/presets/") + preset.name + ".toml");
+  std::vector<bool> notes(128, false);
+  std::vector<SynthEvent> strike;
+  for (int key = instrument.lowestNote; key <= instrument.highestNote; key += preset.everyNth) {
+    notes[key] = true;
+    strike.push_back({0, {0x90, static_cast<std::uint8_t>(key), 90}});
+  }
+  const int keys = static_cast<int>(strike.size());
+  Synth synth;
+  synth.prepare({instrument},
+                {.sampleRate = kSampleRate, .maxBlock = kBlockSize, .notes = notes, .threads = 1});
+  synth.setPolyphony(keys);
+  std::vector<float> left(kBlockSize), right(kBlockSize);
+  const int restrike = static_cast<int>(kRestrikeS * kSampleRate / kBlockSize);
+  int blocks = 0;
+  for (auto _ : state) {
+    const bool now = blocks++ % restrike == 0;
+    synth.process(left, right,
+                  now ? std::span<const SynthEvent>(strike) : std::span<const SynthEvent>());
+    benchmark::DoNotOptimize(left.data());
+  }
+  if (synth.activeVoices() != keys) state.SkipWithError("not every key kept sounding");
+  state.SetLabel(preset.name);
+  state.counters["keys"] = keys;
+  state.counters["polyphony"] = instrument.polyphony;
+  state.counters["t/key/sample"] =
+      benchmark::Counter(static_cast<double>(state.iterations()) * kBlockSize * keys,
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+// The console table, then one line per preset: its keys per core in real time.
+class CostReporter : public benchmark::ConsoleReporter {
+ public:
+  CostReporter() : ConsoleReporter(OO_Tabular) {}
+  void ReportRuns(const std::vector<Run>& runs) override {
+    ConsoleReporter::ReportRuns(runs);
+    for (const Run& run : runs) {
+      const auto perKey = run.counters.find("t/key/sample");
+      const bool median = run.run_type == Run::RT_Aggregate && run.aggregate_name == "median";
+      if (run.error_occurred || perKey == run.counters.end() ||
+          !(median || (run.run_type == Run::RT_Iteration && run.repetitions <= 1)))
+        continue;
+      lines[run.report_label] = {perKey->second.value, run.counters.at("polyphony").value};
+    }
+  }
+  struct Line {
+    double secondsPerKeySample, polyphony;
+  };
+  std::map<std::string, Line> lines;
+};
+
+}  // namespace
+}  // namespace hamiltone
+
+BENCHMARK(hamiltone::presetCost)
+    ->ArgName("preset")
+    ->DenseRange(0, std::size(hamiltone::kPresets) - 1)
+    ->Unit(benchmark::kMillisecond);
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  hamiltone::CostReporter reporter;
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+  std::printf("\n%-16s %16s %14s %10s\n", "preset", "% of a core/key", "keys per core",
+              "polyphony");
+  for (const auto& [name, line] : reporter.lines) {
+    const double coreFraction = line.secondsPerKeySample * hamiltone::kSampleRate;
+    std::printf("%-16s %16.1f %14.1f %10.0f\n", name.c_str(), 100.0 * coreFraction,
+                1.0 / coreFraction, line.polyphony);
+  }
+  benchmark::Shutdown();
+}
