@@ -68,11 +68,7 @@ void NonlinearString::applyStiffness(const Vector& q, Vector& out) const {
   }
   // h (−βT0 D2 + EI D2²) u. D2² with D2 u = 0 at the ends is the simply supported biharmonic.
   const double ei = physics_.young * physics_.inertia * h_;
-  double* d2u = work1_.data();
-  double* d4u = work2_.data();
-  kernels_->secondDifference(q.data(), d2u, n, invH2);
-  kernels_->secondDifference(d2u, d4u, n, invH2);
-  for (Eigen::Index j = 0; j < n; ++j) out[j] = -t * d2u[j] + ei * d4u[j];
+  kernels_->stiffStencil(q.data(), work1_.data(), out.data(), n, invH2, t, ei);
 }
 
 double NonlinearString::transverseEigenvalue(int m) const {

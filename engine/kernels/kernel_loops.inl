@@ -90,6 +90,20 @@ HAMILTONE_TARGET void secondDifference(const double* a, double* out, long n, dou
   out[n - 1] = c * (a[n - 2] - 2.0 * a[n - 1]);
 }
 
+HAMILTONE_TARGET void stiffStencil(const double* a, double* d2, double* out, long n, double invH2,
+                                   double t, double ei) {
+  secondDifference(a, d2, n, invH2);
+  if (n == 1) {
+    out[0] = -t * d2[0] + ei * (-2.0 * invH2 * d2[0]);
+    return;
+  }
+  out[0] = -t * d2[0] + ei * (invH2 * (d2[1] - 2.0 * d2[0]));
+#pragma omp simd
+  for (long j = 1; j < n - 1; ++j)
+    out[j] = -t * d2[j] + ei * (invH2 * (d2[j - 1] - 2.0 * d2[j] + d2[j + 1]));
+  out[n - 1] = -t * d2[n - 1] + ei * (invH2 * (d2[n - 2] - 2.0 * d2[n - 1]));
+}
+
 HAMILTONE_TARGET void secondDifferenceOfDifference(const double* a, const double* b, double* out,
                                                    long n, double c) {
   if (n == 1) {
@@ -231,6 +245,7 @@ extern const Kernels kernels{.isa = HAMILTONE_KERNEL_ISA,
                              .fineForces = fineForces,
                              .singleGridForces = singleGridForces,
                              .secondDifference = secondDifference,
+                             .stiffStencil = stiffStencil,
                              .secondDifferenceOfDifference = secondDifferenceOfDifference,
                              .savDots = savDots,
                              .savUpdate = savUpdate,

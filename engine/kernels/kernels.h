@@ -32,6 +32,11 @@ struct Kernels {
                              double* wz, double* we, double* gu, double* gv);
   // out_j = c (a_{j−1} − 2a_j + a_{j+1}), j < n, a = 0 beyond both ends.
   void (*secondDifference)(const double* a, double* out, long n, double c);
+  // The stiff string's h (−βT0 D2 + EI D2²) a, D2 a = 0 at the ends (simply supported): d2 =
+  // invH2 D2 a (n values), then out_j = −t d2_j + ei invH2 (D2 d2)_j in one more sweep — the
+  // operations of two secondDifference passes and the sum, one pass fewer.
+  void (*stiffStencil)(const double* a, double* d2, double* out, long n, double invH2, double t,
+                       double ei);
   // The same of a − b, the difference taken as it is read.
   void (*secondDifferenceOfDifference)(const double* a, const double* b, double* out, long n,
                                        double c);

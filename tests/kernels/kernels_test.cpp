@@ -45,6 +45,15 @@ TEST(Kernels, StencilsAndStretchesAreBitIdenticalOnEveryPath) {
       base.secondDifference(a.data(), x.data(), n, -3.7);
       path->secondDifference(a.data(), y.data(), n, -3.7);
       EXPECT_EQ(x, y) << path->name << " n = " << n;
+      // The stiff stencil: the two second differences and their sum, the same operations.
+      std::vector<double> d2(n), d4(n), stiff(n), scratch1(n), scratch2(n);
+      base.secondDifference(a.data(), d2.data(), n, 1e4);
+      base.secondDifference(d2.data(), d4.data(), n, 1e4);
+      for (long j = 0; j < n; ++j) stiff[j] = -3.0 * d2[j] + 2e-5 * d4[j];
+      base.stiffStencil(a.data(), scratch1.data(), x.data(), n, 1e4, 3.0, 2e-5);
+      path->stiffStencil(a.data(), scratch2.data(), y.data(), n, 1e4, 3.0, 2e-5);
+      EXPECT_EQ(x, stiff) << "portable n = " << n;
+      EXPECT_EQ(x, y) << path->name << " n = " << n;
       base.secondDifferenceOfDifference(a.data(), b.data(), x.data(), n, 2.1);
       path->secondDifferenceOfDifference(a.data(), b.data(), y.data(), n, 2.1);
       EXPECT_EQ(x, y) << path->name << " n = " << n;
