@@ -28,11 +28,20 @@ namespace {
 std::atomic<AudioOutput::Impl*> errorSink{nullptr};
 
 // Called by RtAudio on its own threads for a stream error (not on the real-time path).
+// RtAudio 5's JACK stream cannot follow a change of the server's buffer size (jack_bufsize, or
+// PipeWire changing its quantum): from then on it calls our callback no more and reports only a
+// warning each period. Taken as the stream's end, so that the player says so and stops.
 void streamError(RtAudioError::Type type, const std::string& text) {
-  if (type == RtAudioError::WARNING || type == RtAudioError::DEBUG_WARNING) return;
+  const bool bufferChanged = text.find("buffer size has changed") != std::string::npos;
+  if ((type == RtAudioError::WARNING || type == RtAudioError::DEBUG_WARNING) && !bufferChanged)
+    return;
   AudioOutput::Impl* impl = errorSink.load();
   if (!impl || impl->failed.load()) return;
-  std::snprintf(impl->failure, sizeof impl->failure, "%s", text.c_str());
+  std::snprintf(impl->failure, sizeof impl->failure, "%s",
+                bufferChanged ? "the JACK server's buffer size changed while playing (jack_bufsize, "
+                                "or PipeWire's quantum), which the stream cannot follow; start "
+                                "hamiltone-play again to play at the new size"
+                              : text.c_str());
   impl->failed.store(true);
 }
 
@@ -175,10 +184,13 @@ void AudioOutput::start() {
   }
 }
 
+// abortStream, not stopStream: RtAudio's JACK stopStream() waits for the callback to drain the
+// output, and hangs forever when the callback is no longer called (the server's buffer size
+// changed, see streamError). What is dropped is at most the device's last buffer.
 void AudioOutput::stop() {
   impl_->stopped = true;
   if (impl_->audio && impl_->audio->isStreamOpen() && impl_->audio->isStreamRunning())
-    impl_->audio->stopStream();
+    impl_->audio->abortStream();
 }
 
 long AudioOutput::underruns() const { return impl_->underruns.load(); }

@@ -424,6 +424,24 @@ TEST_F(JackPlay, ALostServerEndsThePlayerWithTheRecordingComplete) {
   }
 }
 
+// The JACK server's buffer size changed while playing (jack_bufsize; PipeWire changes its quantum
+// by itself): RtAudio's stream cannot follow — it calls the player no more and reports only a
+// warning — and its stopStream() waits for a callback that never comes. The player played on in
+// silence, saying nothing, and hung on Ctrl-C with the recording lost (its temporary left); now it
+// says why and exits 3 with the recording complete, as when the server goes away.
+TEST_F(JackPlay, ABufferSizeChangeEndsThePlayerWithTheRecordingComplete) {
+  if (!onPath("jackd") || !onPath("jack_lsp") || !onPath("jack_bufsize"))
+    GTEST_SKIP() << "jackd and jack_bufsize (Debian's jackd2) are not installed";
+  ASSERT_NO_FATAL_FAILURE(startServer(false));
+  ASSERT_NO_FATAL_FAILURE(
+      startPlayer({"--preset", HAMILTONE_SOURCE_DIR "/presets/paper-c3-string.toml"}));
+  std::this_thread::sleep_for(500ms);  // something to record
+  std::optional<Child> bufsize;
+  spawn(bufsize, {"jack_bufsize", std::to_string(2 * kPeriod)}, "bufsize");
+  ASSERT_EQ(bufsize->wait(10.0), 0) << slurp(dir_ / "bufsize.err");
+  expectEndedWithTheRecording(player_, dir_, 3, "the JACK server's buffer size changed", 1);
+}
+
 // Recording onto a disk that fills (a 64 KiB tmpfs: 0.23 s of 24-bit stereo at 48 kHz): the
 // player says the recording stopped, plays on, and on SIGINT keeps the WAV up to the error and
 // exits 1 — where it aborted (exit 134) and left its temporary.
