@@ -7,6 +7,7 @@
 #include <CLI/Config.hpp>
 #include <CLI/Formatter.hpp>
 #include <CLI/Validators.hpp>
+#include <algorithm>
 #include <csignal>
 #include <cstdio>
 #include <ctime>
@@ -74,6 +75,23 @@ unsigned playingRate(AudioOutput& audio, int output, unsigned requested) {
     std::fprintf(stderr, "hamiltone-play: %s runs at %u Hz: playing at %u Hz, not %u\n",
                  server.c_str(), rate, rate, requested);
   return rate;
+}
+
+// A score that sounds nothing, in part or at all, is said (as hamiltone-render says it): notes no
+// preset plays, or a MIDI file with no note in it.
+void warnSilentScore(const Score& score, const std::vector<Instrument>& instruments) {
+  if (score.what.empty()) return;
+  const bool anyNote = std::any_of(score.messages.begin(), score.messages.end(),
+                                   [](const TimedMessage& m) {
+                                     return m.message.kind() == midi::noteOn && m.message.data2 > 0;
+                                   });
+  const std::string outside = cli::unplayedNotes(score.messages, instruments);
+  if (!anyNote)
+    std::fprintf(stderr, "hamiltone-play: warning: %s has no note to play\n", score.what.c_str());
+  else if (!outside.empty())
+    std::fprintf(stderr,
+                 "hamiltone-play: warning: no preset plays MIDI note(s)%s; they are silent\n",
+                 outside.c_str());
 }
 
 // No MIDI input port was asked for: what there is, and how to choose one.
@@ -194,6 +212,7 @@ int play(const PlayArguments& a) {
   // switches between instruments that are ready.
   std::vector<Instrument> instruments = cli::loadPresets(
       a.presets.empty() ? std::vector<std::string>{HAMILTONE_DEFAULT_PRESET} : a.presets, a.sets);
+  warnSilentScore(score, instruments);
 
   AudioOutput audio(a.api);  // AudioError: exit 2 with what exists
   const int output = audio.resolve(device);
@@ -213,7 +232,7 @@ int play(const PlayArguments& a) {
   if (!a.record.empty()) recorder = std::make_unique<Recorder>(a.record, static_cast<int>(rate));
   Player player(synth, midi.queue(), recorder ? &recorder->ring() : nullptr, rate, 8192,
                 cpuLimit / 100.0);
-  player.setScore(score.messages);
+  if (!score.what.empty()) player.setScore(score.messages);
 
   audio.open(output, rate, buffer, [&player](float* out, int frames, bool) {
     player.render(out, frames, steadyNanoseconds());

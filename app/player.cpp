@@ -32,6 +32,7 @@ void Player::setScore(std::span<const TimedMessage> score) {
   for (const TimedMessage& m : score)
     score_.push_back({std::llround(m.seconds * sampleRate_), m.message});
   nextScored_ = 0;
+  hasScore_ = true;
 }
 
 // The score's messages due before the block's end, at their offsets (one due before the block —
@@ -103,7 +104,7 @@ void Player::render(float* interleaved, int frames, std::int64_t nowNs) noexcept
   const int voices = synth_.activeVoices();
   voices_.store(voices, std::memory_order_relaxed);
   guard_.store(synth_.guardEvents(), std::memory_order_relaxed);
-  if (!score_.empty() && nextScored_ == score_.size() && voices == 0)
+  if (hasScore_ && nextScored_ == score_.size() && voices == 0)
     finished_.store(true, std::memory_order_relaxed);
 }
 

@@ -378,5 +378,24 @@ TEST(Player, FinishedOnceTheScoreIsPlayedAndSilent) {
   EXPECT_FALSE(live.status().finished);
 }
 
+// A score with nothing in it — a valid MIDI file with no channel message, only meta events — is
+// played to its end at once. It was taken for no score at all: hamiltone-play --midi on such a
+// file played silence forever, listening to no MIDI input and saying nothing.
+TEST(Player, AnEmptyScoreIsFinishedOnceTheKeysAreSilent) {
+  constexpr int kFrames = 256;
+  Synth synth = prepared({pianoKeys(48, 52)});
+  SpscQueue<StampedMessage> midi(16);
+  Player player(synth, midi, nullptr, kRate, kFrames);
+  player.setScore({});
+  std::vector<float> interleaved(2 * kFrames);
+  // A key played live keeps it from finishing while it sounds.
+  ASSERT_TRUE(midi.push({before(100), {0x90, 48, 100}}));
+  player.render(interleaved.data(), kFrames, kNow);
+  EXPECT_FALSE(player.status().finished);
+  ASSERT_TRUE(midi.push({before(100), {0xB0, 120, 0}}));  // all sound off
+  for (int b = 0; b < 4; ++b) player.render(interleaved.data(), kFrames, kNow);
+  EXPECT_TRUE(player.status().finished);
+}
+
 }  // namespace
 }  // namespace hamiltone::app

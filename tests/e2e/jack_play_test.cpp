@@ -528,6 +528,15 @@ TEST_F(JackPlay, NotesPlayOnPitchAtTheServersRateAndEnd) {
   }
 }
 
+// A format 0 file of `track` at 480 ticks a quarter, written to `path`; returns `path`.
+fs::path writeMidi(const fs::path& path, const hamiltone::testing::TrackWriter& track) {
+  const hamiltone::testing::Bytes bytes = hamiltone::testing::midiFile(0, 480, {track});
+  std::ofstream(path, std::ios::binary)
+      .write(reinterpret_cast<const char*>(bytes.data()),
+             static_cast<std::streamsize>(bytes.size()));
+  return path;
+}
+
 // --midi FILE: played live from the stream's first sample, its events on their samples (the file's
 // note at 0.5 s starts there, to the hammer's few milliseconds, whatever the wall clock did), and
 // the player ends by itself, exit 0, after the last note died away.
@@ -538,11 +547,7 @@ TEST_F(JackPlay, MidiFilePlaysOnItsSamplesAndEnds) {
   // 480 ticks a quarter at the default 120 bpm: a tick is 1/960 s. C4 from 0.5 s to 2 s.
   TrackWriter track;
   track.event(0, {0xC0, 0}).event(480, {0x90, 60, 90}).event(1440, {0x80, 60, 0}).endOfTrack(0);
-  const fs::path midi = dir_ / "c4.mid";
-  const hamiltone::testing::Bytes bytes = hamiltone::testing::midiFile(0, 480, {track});
-  std::ofstream(midi, std::ios::binary)
-      .write(reinterpret_cast<const char*>(bytes.data()),
-             static_cast<std::streamsize>(bytes.size()));
+  const fs::path midi = writeMidi(dir_ / "c4.mid", track);
   ASSERT_NO_FATAL_FAILURE(startServer(false));
   const std::optional<int> code = playToTheEnd(
       {"--preset", HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml", "--midi", midi.string()});
@@ -558,6 +563,34 @@ TEST_F(JackPlay, MidiFilePlaysOnItsSamplesAndEnds) {
   EXPECT_LT(at, 24000 + 480) << "the note starts " << (at - 24000) / kRate << " s late";
   EXPECT_NEAR(off, 0.0, 3.0);
   EXPECT_LT(x.size(), static_cast<size_t>(10 * kRate));  // it ended after the tail, not later
+}
+
+// A score whose notes no preset plays (the piano's keys are A0 … C8) sounds nothing: the player
+// says so, naming the notes, as hamiltone-render does, where it "played --notes to the end" in
+// silence without a word; and a MIDI file with no note at all (only meta events) is played to its
+// end at once with a warning, where the player played silence forever.
+TEST_F(JackPlay, WarnsOfAScoreThatSoundsNothing) {
+  if (!onPath("jackd") || !onPath("jack_lsp"))
+    GTEST_SKIP() << "jackd (Debian's jackd2) is not installed";
+  using hamiltone::testing::TrackWriter;
+  TrackWriter track;
+  track.endOfTrack(0);
+  const fs::path midi = writeMidi(dir_ / "empty.mid", track);
+  ASSERT_NO_FATAL_FAILURE(startServer(false));
+  const std::string piano = HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml";
+  for (const auto& [score, mention] :
+       {std::pair<std::vector<std::string>, std::string>{
+            {"--notes", "5:100:0.1, A4:80:0.1, 120:100:0.1"},
+            "warning: no preset plays MIDI note(s) 5 120; they are silent"},
+        {{"--midi", midi.string()}, "warning: --midi " + midi.string() + " has no note to play"}}) {
+    std::vector<std::string> args = {"--quiet", "--preset", piano};
+    args.insert(args.end(), score.begin(), score.end());
+    const std::optional<int> code = playToTheEnd(args);
+    const std::string err = slurp(dir_ / "player.err");
+    EXPECT_EQ(code, 0) << err;
+    EXPECT_NE(err.find(mention), std::string::npos) << err;
+    EXPECT_NE(err.find("to the end"), std::string::npos) << err;
+  }
 }
 
 // No MIDI input asked for: a warning naming the ports there are and how to choose one. A port
