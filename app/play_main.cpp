@@ -37,6 +37,7 @@ struct PlayArguments {
   std::string api = "jack", device, sampleRate = "48000", buffer = "128", midiPort, virtualMidi;
   std::string record, voices, threads, midi, notes, cpuLimit = "80";
   bool listDevices = false, quiet = false, keepListening = false;
+  bool midiGiven = false, notesGiven = false;  // even empty: "" is not the same as no option
 };
 
 // What --midi FILE or --notes LIST plays, read and checked before any device is opened.
@@ -46,17 +47,19 @@ struct Score {
 };
 
 Score readScore(const PlayArguments& a) {
-  if (!a.midi.empty() && !a.notes.empty())
+  if (a.midiGiven && a.notesGiven)
     throw cli::UsageError("give at most one of --midi FILE and --notes LIST");
   Score score;
-  if (!a.midi.empty()) {
+  if (a.midiGiven) {
+    if (a.midi.empty())
+      throw cli::UsageError("--midi: the file name is empty; give a Standard MIDI File");
     try {
       score.messages = readMidiFile(a.midi).messages;
     } catch (const MidiFileError& e) {  // "<file>: byte N: what is wrong", or "<file>: why"
       throw cli::UsageError(std::string("--midi: ") + e.what());
     }
     score.what = "--midi " + a.midi;
-  } else if (!a.notes.empty()) {
+  } else if (a.notesGiven) {
     score.messages = cli::parseNoteList(a.notes).messages;
     score.what = "--notes";
   }
@@ -438,6 +441,8 @@ int main(int argc, char** argv) {
       "playing (the recording is complete up to then).");
   try {
     app.parse(argc, argv);
+    a.midiGiven = app.count("--midi") > 0;
+    a.notesGiven = app.count("--notes") > 0;
   } catch (const CLI::Success& e) {  // --help, --version
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
