@@ -235,7 +235,7 @@ int play(const PlayArguments& a) {
   if (!a.record.empty()) recorder = std::make_unique<Recorder>(a.record, static_cast<int>(rate));
   Player player(synth, midi.queue(), recorder ? &recorder->ring() : nullptr, rate, 8192,
                 cpuLimit / 100.0);
-  if (!score.what.empty()) player.setScore(score.messages);
+  if (!score.what.empty()) player.setScore(score.messages, !a.keepListening);
 
   audio.open(output, rate, buffer, [&player](float* out, int frames, bool) {
     player.render(out, frames, steadyNanoseconds());
