@@ -184,13 +184,19 @@ void AudioOutput::start() {
   }
 }
 
-// abortStream, not stopStream: RtAudio's JACK stopStream() waits for the callback to drain the
-// output, and hangs forever when the callback is no longer called (the server's buffer size
-// changed, see streamError). What is dropped is at most the device's last buffer.
+// RtAudio's JACK stopStream() waits until the callback has run twice more without calling ours,
+// so that jack_deactivate() — which cancels the process thread asynchronously — never finds our
+// render running (cancelled inside it, a noexcept function, the program would terminate). But
+// after a stream failure (the server's buffer size changed, see streamError) the callback is
+// called no more and that wait would never end: then abortStream(), which skips it; our render is
+// not running then.
 void AudioOutput::stop() {
   impl_->stopped = true;
-  if (impl_->audio && impl_->audio->isStreamOpen() && impl_->audio->isStreamRunning())
+  if (!impl_->audio || !impl_->audio->isStreamOpen() || !impl_->audio->isStreamRunning()) return;
+  if (impl_->failed.load())
     impl_->audio->abortStream();
+  else
+    impl_->audio->stopStream();
 }
 
 long AudioOutput::underruns() const { return impl_->underruns.load(); }

@@ -50,7 +50,7 @@ class AudioOutput {
   void open(int device, unsigned sampleRate, unsigned& bufferFrames, Render render);
   unsigned streamRate() const;  // the open stream's rate
   void start();
-  void stop();  // waits for the callback to finish (drops what the device still buffers); safe twice
+  void stop();  // waits for the callback to finish; safe to call twice
   long underruns() const;
   // Whether the started stream ended without stop(): the server went away (JACK shuts its clients
   // down, and RtAudio then closes the stream) or RtAudio reported an error. From the main thread,
