@@ -38,10 +38,11 @@ void streamError(RtAudioError::Type type, const std::string& text) {
   AudioOutput::Impl* impl = errorSink.load();
   if (!impl || impl->failed.load()) return;
   std::snprintf(impl->failure, sizeof impl->failure, "%s",
-                bufferChanged ? "the JACK server's buffer size changed while playing (jack_bufsize, "
-                                "or PipeWire's quantum), which the stream cannot follow; start "
-                                "hamiltone-play again to play at the new size"
-                              : text.c_str());
+                bufferChanged
+                    ? "the JACK server's buffer size changed while playing (jack_bufsize, "
+                      "or PipeWire's quantum), which the stream cannot follow; start "
+                      "hamiltone-play again to play at the new size"
+                    : text.c_str());
   impl->failed.store(true);
 }
 

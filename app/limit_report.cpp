@@ -33,8 +33,8 @@ std::string LimitReport::update(const Player::Status& status, double seconds) {
                   "voice limit lowered%s %s: the audio callback took %.0f%% of its "
                   "%.1f ms period (%d frames at %.0f Hz), over the %g%% budget; to keep more "
                   "voices use a larger buffer (%s%d)%s, or fewer --voices",
-                  times, now, 100.0 * status.dropLoad, periodMs,
-                  context_.frames, context_.sampleRate, 100.0 * context_.budget,
+                  times, now, 100.0 * status.dropLoad, periodMs, context_.frames,
+                  context_.sampleRate, 100.0 * context_.budget,
                   context_.jack ? "the JACK server's period, jackd -p " : "--buffer ",
                   2 * context_.frames, threads);
     return line;

@@ -84,10 +84,10 @@ unsigned playingRate(AudioOutput& audio, int output, unsigned requested) {
 // preset plays, or a MIDI file with no note in it.
 void warnSilentScore(const Score& score, const std::vector<Instrument>& instruments) {
   if (score.what.empty()) return;
-  const bool anyNote = std::any_of(score.messages.begin(), score.messages.end(),
-                                   [](const TimedMessage& m) {
-                                     return m.message.kind() == midi::noteOn && m.message.data2 > 0;
-                                   });
+  const bool anyNote =
+      std::any_of(score.messages.begin(), score.messages.end(), [](const TimedMessage& m) {
+        return m.message.kind() == midi::noteOn && m.message.data2 > 0;
+      });
   const std::string outside = cli::unplayedNotes(score.messages, instruments);
   if (!anyNote)
     std::fprintf(stderr, "hamiltone-play: warning: %s has no note to play\n", score.what.c_str());
