@@ -28,11 +28,21 @@ namespace {
 std::atomic<AudioOutput::Impl*> errorSink{nullptr};
 
 // Called by RtAudio on its own threads for a stream error (not on the real-time path).
+// RtAudio 5's JACK stream cannot follow a change of the server's buffer size (jack_bufsize, or
+// PipeWire changing its quantum): from then on it calls our callback no more and reports only a
+// warning each period. Taken as the stream's end, so that the player says so and stops.
 void streamError(RtAudioError::Type type, const std::string& text) {
-  if (type == RtAudioError::WARNING || type == RtAudioError::DEBUG_WARNING) return;
+  const bool bufferChanged = text.find("buffer size has changed") != std::string::npos;
+  if ((type == RtAudioError::WARNING || type == RtAudioError::DEBUG_WARNING) && !bufferChanged)
+    return;
   AudioOutput::Impl* impl = errorSink.load();
   if (!impl || impl->failed.load()) return;
-  std::snprintf(impl->failure, sizeof impl->failure, "%s", text.c_str());
+  std::snprintf(impl->failure, sizeof impl->failure, "%s",
+                bufferChanged
+                    ? "the JACK server's buffer size changed while playing (jack_bufsize, "
+                      "or PipeWire's quantum), which the stream cannot follow; start "
+                      "hamiltone-play again to play at the new size"
+                    : text.c_str());
   impl->failed.store(true);
 }
 
@@ -175,9 +185,18 @@ void AudioOutput::start() {
   }
 }
 
+// RtAudio's JACK stopStream() waits until the callback has run twice more without calling ours,
+// so that jack_deactivate() — which cancels the process thread asynchronously — never finds our
+// render running (cancelled inside it, a noexcept function, the program would terminate). But
+// after a stream failure (the server's buffer size changed, see streamError) the callback is
+// called no more and that wait would never end: then abortStream(), which skips it; our render is
+// not running then.
 void AudioOutput::stop() {
   impl_->stopped = true;
-  if (impl_->audio && impl_->audio->isStreamOpen() && impl_->audio->isStreamRunning())
+  if (!impl_->audio || !impl_->audio->isStreamOpen() || !impl_->audio->isStreamRunning()) return;
+  if (impl_->failed.load())
+    impl_->audio->abortStream();
+  else
     impl_->audio->stopStream();
 }
 

@@ -1,8 +1,9 @@
 // What the player says when its overload protection lowered the voice limit (Player::protect):
 // from the main thread, which polls Player::status(), never from the audio thread; at most one
-// line every kInterval seconds, saying how often it dropped since the last line, the callback's
-// load that made it drop against the budget, the new limit, and what would avoid it. And one line
-// when the limit is back at the polyphony.
+// line every kInterval seconds, even when the limit came back in between, saying how often it
+// dropped since the last line, the callback's load that made it drop against the budget, the new
+// limit (or that it is back already), and what would avoid it. And one line when the limit is back
+// at the polyphony.
 #pragma once
 
 #include <string>
@@ -34,6 +35,7 @@ class LimitReport {
   long reportedDrops_ = 0;
   double lastLine_ = 0.0;
   bool lowered_ = false;  // a drop was reported and the limit is not back yet
+  bool said_ = false;     // a drop was reported (at lastLine_)
 };
 
 }  // namespace hamiltone::app

@@ -25,6 +25,16 @@ std::string portList(const std::vector<std::string>& names) {
 }
 
 std::string stablePortName(const std::string& name) {
+  // a2j's "a2j:CLIENT [N] (capture): PORT": N is the ALSA client number.
+  if (name.rfind("a2j:", 0) == 0) {
+    const size_t open = name.find(" ["),
+                 close = name.find("] (", open == std::string::npos ? 0 : open);
+    if (open != std::string::npos && close != std::string::npos && close > open + 2 &&
+        std::all_of(name.begin() + static_cast<long>(open) + 2,
+                    name.begin() + static_cast<long>(close),
+                    [](char c) { return c >= '0' && c <= '9'; }))
+      return name.substr(0, open) + name.substr(close + 1);
+  }
   const size_t space = name.rfind(' ');
   if (space == std::string::npos) return name;
   const std::string tail = name.substr(space + 1);

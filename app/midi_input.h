@@ -31,7 +31,8 @@ std::int64_t steadyNanoseconds();
 std::string portList(const std::vector<std::string>& names);
 
 // A port's name without the " CLIENT:PORT" numbers RtMidi appends on ALSA ("Keystation 88:
-// Keystation 88 MIDI 1 24:0"), which a keyboard plugged in again may change.
+// Keystation 88 MIDI 1 24:0"), or the " [CLIENT]" of a2j's JACK names ("a2j:Keystation [24]
+// (capture): Keystation 88 MIDI 1"), which a keyboard plugged in again may change.
 std::string stablePortName(const std::string& name);
 
 class MidiInput {

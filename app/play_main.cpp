@@ -7,6 +7,7 @@
 #include <CLI/Config.hpp>
 #include <CLI/Formatter.hpp>
 #include <CLI/Validators.hpp>
+#include <algorithm>
 #include <csignal>
 #include <cstdio>
 #include <ctime>
@@ -36,6 +37,7 @@ struct PlayArguments {
   std::string api = "jack", device, sampleRate = "48000", buffer = "128", midiPort, virtualMidi;
   std::string record, voices, threads, midi, notes, cpuLimit = "80";
   bool listDevices = false, quiet = false, keepListening = false;
+  bool midiGiven = false, notesGiven = false;  // even empty: "" is not the same as no option
 };
 
 // What --midi FILE or --notes LIST plays, read and checked before any device is opened.
@@ -45,17 +47,19 @@ struct Score {
 };
 
 Score readScore(const PlayArguments& a) {
-  if (!a.midi.empty() && !a.notes.empty())
+  if (a.midiGiven && a.notesGiven)
     throw cli::UsageError("give at most one of --midi FILE and --notes LIST");
   Score score;
-  if (!a.midi.empty()) {
+  if (a.midiGiven) {
+    if (a.midi.empty())
+      throw cli::UsageError("--midi: the file name is empty; give a Standard MIDI File");
     try {
       score.messages = readMidiFile(a.midi).messages;
     } catch (const MidiFileError& e) {  // "<file>: byte N: what is wrong", or "<file>: why"
       throw cli::UsageError(std::string("--midi: ") + e.what());
     }
     score.what = "--midi " + a.midi;
-  } else if (!a.notes.empty()) {
+  } else if (a.notesGiven) {
     score.messages = cli::parseNoteList(a.notes).messages;
     score.what = "--notes";
   }
@@ -74,6 +78,23 @@ unsigned playingRate(AudioOutput& audio, int output, unsigned requested) {
     std::fprintf(stderr, "hamiltone-play: %s runs at %u Hz: playing at %u Hz, not %u\n",
                  server.c_str(), rate, rate, requested);
   return rate;
+}
+
+// A score that sounds nothing, in part or at all, is said (as hamiltone-render says it): notes no
+// preset plays, or a MIDI file with no note in it.
+void warnSilentScore(const Score& score, const std::vector<Instrument>& instruments) {
+  if (score.what.empty()) return;
+  const bool anyNote =
+      std::any_of(score.messages.begin(), score.messages.end(), [](const TimedMessage& m) {
+        return m.message.kind() == midi::noteOn && m.message.data2 > 0;
+      });
+  const std::string outside = cli::unplayedNotes(score.messages, instruments);
+  if (!anyNote)
+    std::fprintf(stderr, "hamiltone-play: warning: %s has no note to play\n", score.what.c_str());
+  else if (!outside.empty())
+    std::fprintf(stderr,
+                 "hamiltone-play: warning: no preset plays MIDI note(s)%s; they are silent\n",
+                 outside.c_str());
 }
 
 // No MIDI input port was asked for: what there is, and how to choose one.
@@ -194,6 +215,7 @@ int play(const PlayArguments& a) {
   // switches between instruments that are ready.
   std::vector<Instrument> instruments = cli::loadPresets(
       a.presets.empty() ? std::vector<std::string>{HAMILTONE_DEFAULT_PRESET} : a.presets, a.sets);
+  warnSilentScore(score, instruments);
 
   AudioOutput audio(a.api);  // AudioError: exit 2 with what exists
   const int output = audio.resolve(device);
@@ -213,7 +235,7 @@ int play(const PlayArguments& a) {
   if (!a.record.empty()) recorder = std::make_unique<Recorder>(a.record, static_cast<int>(rate));
   Player player(synth, midi.queue(), recorder ? &recorder->ring() : nullptr, rate, 8192,
                 cpuLimit / 100.0);
-  player.setScore(score.messages);
+  if (!score.what.empty()) player.setScore(score.messages, !a.keepListening);
 
   audio.open(output, rate, buffer, [&player](float* out, int frames, bool) {
     player.render(out, frames, steadyNanoseconds());
@@ -419,6 +441,8 @@ int main(int argc, char** argv) {
       "playing (the recording is complete up to then).");
   try {
     app.parse(argc, argv);
+    a.midiGiven = app.count("--midi") > 0;
+    a.notesGiven = app.count("--notes") > 0;
   } catch (const CLI::Success& e) {  // --help, --version
     return app.exit(e);
   } catch (const CLI::ParseError& e) {

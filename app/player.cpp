@@ -26,12 +26,14 @@ Player::Player(Synth& synth, SpscQueue<StampedMessage>& midi, SpscQueue<float>* 
   limitShown_ = limit_;
 }
 
-void Player::setScore(std::span<const TimedMessage> score) {
+void Player::setScore(std::span<const TimedMessage> score, bool endRecording) {
   score_.clear();
   score_.reserve(score.size());
   for (const TimedMessage& m : score)
     score_.push_back({std::llround(m.seconds * sampleRate_), m.message});
   nextScored_ = 0;
+  hasScore_ = true;
+  endRecording_ = endRecording;
 }
 
 // The score's messages due before the block's end, at their offsets (one due before the block —
@@ -88,7 +90,7 @@ void Player::render(float* interleaved, int frames, std::int64_t nowNs) noexcept
     interleaved[2 * i] = left[i];
     interleaved[2 * i + 1] = right[i];
   }
-  if (record_) {
+  if (record_ && !recordingEnded_) {
     const size_t samples = 2 * static_cast<size_t>(frames);
     if (!record_->pushAll(interleaved, samples))  // whole frames, or the block is lost
       recordDropped_.fetch_add(static_cast<long>(samples));
@@ -103,8 +105,10 @@ void Player::render(float* interleaved, int frames, std::int64_t nowNs) noexcept
   const int voices = synth_.activeVoices();
   voices_.store(voices, std::memory_order_relaxed);
   guard_.store(synth_.guardEvents(), std::memory_order_relaxed);
-  if (!score_.empty() && nextScored_ == score_.size() && voices == 0)
+  if (hasScore_ && nextScored_ == score_.size() && voices == 0 && synth_.silent()) {
     finished_.store(true, std::memory_order_relaxed);
+    recordingEnded_ = endRecording_;  // this block was the last one recorded
+  }
 }
 
 // Near the deadline — kOverloadedBlocks blocks in a row over the budget, with keys sounding — the

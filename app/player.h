@@ -40,7 +40,11 @@ class Player {
 
   // A score to play from the first rendered sample on: messages in time order, at their time in
   // seconds rounded to the sample. Before the first render() (it allocates); replaces any other.
-  void setScore(std::span<const TimedMessage> score);
+  // An empty score is played to its end at once (status().finished once no key sounds).
+  // `endRecording`: the recording ends with the block in which the score finished (the player
+  // then exits), so that it is the same in every run at the same block size, rather than going
+  // on for however long the main thread takes to notice.
+  void setScore(std::span<const TimedMessage> score, bool endRecording = false);
 
   // Fills `frames` interleaved stereo frames. A message that arrived a time d before `nowNs`
   // lands d·rate samples before the end of this block: a constant latency of one buffer, and
@@ -57,8 +61,8 @@ class Player {
     std::uint32_t lastMessage = 0;  // status << 16 | data1 << 8 | data2; 0 before any
     long limitDrops = 0;            // times the protection lowered the limit
     double dropLoad = 0.0;          // the highest load of the blocks that made it drop last
-    // The score has been played to its last message and no key sounds any more (false with no
-    // score).
+    // The score has been played to its last message (at once for an empty one) and no key sounds
+    // any more, nor fades out (false with no score).
     bool finished = false;
   };
   Status status() const;  // from any thread
@@ -82,6 +86,8 @@ class Player {
   std::vector<SynthEvent> events_, scored_, merged_;
   std::vector<ScoreEvent> score_;
   size_t nextScored_ = 0;
+  bool hasScore_ = false;  // setScore() was called, even with an empty score
+  bool endRecording_ = false, recordingEnded_ = false;
   std::int64_t position_ = 0;  // samples rendered
   double overload_;
   int fullLimit_ = 0, limit_ = 0, overloadedRun_ = 0;

@@ -56,4 +56,21 @@ std::vector<Instrument> loadPresets(const std::vector<std::string>& files,
   return instruments;
 }
 
+std::string unplayedNotes(std::span<const TimedMessage> messages,
+                          const std::vector<Instrument>& instruments) {
+  std::vector<bool> notes(128, false);
+  for (const TimedMessage& m : messages)
+    if (m.message.kind() == midi::noteOn) notes[m.message.data1 & 0x7F] = true;
+  std::string outside;
+  for (int note = 0; note < 128; ++note) {
+    bool playable = false;
+    for (const Instrument& i : instruments)
+      playable = playable || (note >= i.lowestNote && note <= i.highestNote);
+    if (!notes[note] || playable) continue;
+    outside += ' ';
+    outside += std::to_string(note);
+  }
+  return outside;
+}
+
 }  // namespace hamiltone::cli

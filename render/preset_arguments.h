@@ -3,9 +3,11 @@
 #pragma once
 
 #include <CLI/App.hpp>
+#include <span>
 #include <string>
 #include <vector>
 
+#include "midi/midi_message.h"
 #include "presets/preset_loader.h"
 
 namespace hamiltone::cli {
@@ -21,5 +23,10 @@ std::vector<PresetOverride> parseSets(const std::vector<std::string>& sets);
 // a malformed --set, or for the first name that names no preset.
 std::vector<Instrument> loadPresets(const std::vector<std::string>& files,
                                     const std::vector<std::string>& sets);
+
+// The MIDI notes that `messages` turn on but that no instrument plays, as " 5 120" (empty when
+// every one is played): the players warn of them, as they are silent.
+std::string unplayedNotes(std::span<const TimedMessage> messages,
+                          const std::vector<Instrument>& instruments);
 
 }  // namespace hamiltone::cli

@@ -101,13 +101,7 @@ int run(const RenderArguments& a) {
   std::vector<bool> notes(128, false);
   for (const TimedMessage& m : messages)
     if (m.message.kind() == midi::noteOn) notes[m.message.data1 & 0x7F] = true;
-  std::string outside;
-  for (int note = 0; note < 128; ++note) {
-    bool playable = false;
-    for (const Instrument& i : instruments)
-      playable = playable || (note >= i.lowestNote && note <= i.highestNote);
-    if (notes[note] && !playable) outside += " " + std::to_string(note);
-  }
+  const std::string outside = unplayedNotes(messages, instruments);
   if (!outside.empty() && !a.quiet)
     std::fprintf(stderr,
                  "hamiltone-render: warning: no preset plays MIDI note(s)%s; they are "

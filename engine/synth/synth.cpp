@@ -106,6 +106,13 @@ int Synth::activeVoices() const {
   return count;
 }
 
+bool Synth::silent() const {
+  for (const auto& keys : voices_)
+    for (const KeyVoice& v : keys)
+      if (v.busy()) return false;
+  return true;
+}
+
 int Synth::guardEvents() const {
   int events = 0;
   for (const auto& keys : voices_)

@@ -68,6 +68,9 @@ class Synth {
   void setDamperScale(double scale) noexcept;
   int polyphony() const;
   int activeVoices() const;
+  // No key sounds, fades out or waits to be struck: what comes out now is the master bus's
+  // DC-blocker tail at most. (activeVoices() does not count a key fading out.)
+  bool silent() const;
   int program() const { return program_; }
   int guardEvents() const;
   long nonFiniteSamples() const { return master_.nonFinite(); }

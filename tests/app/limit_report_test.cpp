@@ -65,7 +65,38 @@ TEST(LimitReport, IsRateLimitedAndCountsTheDropsBetweenLines) {
   EXPECT_EQ(report.update(dropped(3, 14, 0.95), 15.25), "");  // rising: nothing yet
   EXPECT_EQ(report.update(dropped(3, 16, 0.95), 18.0), "voice limit back to 16");
   EXPECT_EQ(report.update(dropped(3, 16, 0.95), 18.25), "");
-  EXPECT_THAT(report.update(dropped(4, 15, 0.85), 19.0), HasSubstr("lowered to 15 of 16"));
+  // Back, then down again: still no more than a line of it every kInterval.
+  EXPECT_EQ(report.update(dropped(4, 15, 0.85), 19.0), "");
+  EXPECT_THAT(report.update(dropped(4, 15, 0.85), 20.0), HasSubstr("lowered to 15 of 16"));
+}
+
+// A load that hovers at the budget: the limit drops by one, comes back after a second of
+// headroom, drops again … The lines came two a cycle (lowered, back), every 1.25 s here, where
+// the README promises one every 5 s at most; and drops reported after the limit came back say so.
+TEST(LimitReport, ALimitThatComesAndGoesIsStillSaidOnceEveryInterval) {
+  LimitReport report(context());
+  long drops = 0;
+  int lowered = 0, back = 0;
+  std::string last;
+  for (int step = 0; step <= 80; ++step) {  // 20 s, polled every 0.25 s
+    const double t = 0.25 * step;
+    if (step % 5 == 0) ++drops;  // down at 0, 1.25, 2.5 … s, back 1 s later
+    const int limit = step % 5 < 4 ? 15 : 16;
+    const std::string line = report.update(dropped(drops, limit, 0.85), t);
+    if (line.find("lowered") != std::string::npos) ++lowered, last = line;
+    if (line.find("back") != std::string::npos && line.find("lowered") == std::string::npos) ++back;
+  }
+  EXPECT_LE(lowered, 5);  // at 0, 5, 10, 15 and 20 s
+  EXPECT_LE(back, lowered);
+  EXPECT_THAT(last, HasSubstr("lowered (4 times) to 15 of 16"));
+  // Drops that were all undone by the time they are said.
+  LimitReport later(context());
+  EXPECT_THAT(later.update(dropped(1, 15, 0.9), 0.0), HasSubstr("lowered to 15"));
+  EXPECT_EQ(later.update(dropped(1, 16, 0.9), 1.0), "voice limit back to 16");
+  EXPECT_EQ(later.update(dropped(2, 15, 0.9), 2.0), "");
+  EXPECT_THAT(later.update(dropped(2, 16, 0.9), 5.0),
+              HasSubstr("voice limit lowered and back to 16: the audio callback took 90%"));
+  EXPECT_EQ(later.update(dropped(2, 16, 0.9), 6.0), "");
 }
 
 }  // namespace

@@ -116,6 +116,20 @@ TEST_F(PlayCli, RefusesABadNoteListAsTheRendererDoes) {
   }
 }
 
+// An empty --notes or --midi (a shell variable that was not set) is refused as the list or the
+// file it is not; both were taken for no score at all, and the player listened for MIDI instead.
+TEST_F(PlayCli, RefusesAnEmptyNoteListOrMidiFileName) {
+  for (const auto& [args, mention] :
+       {std::pair<std::string, std::string>{"--notes ''", "--notes: item 1 \"\": empty"},
+        {"--midi ''", "--midi: the file name is empty"},
+        {"--notes '' --midi x.mid", "at most one of --midi FILE and --notes LIST"}}) {
+    const CommandResult r = play("--quiet " + args);
+    EXPECT_EQ(r.exitCode, 2) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find(mention), std::string::npos) << args << "\n" << r.err;
+    EXPECT_EQ(r.err.find("audio"), std::string::npos) << args << "\n" << r.err;
+  }
+}
+
 TEST_F(PlayCli, RefusesConflictingOrOutOfRangeOptions) {
   for (const auto& [args, mention] :
        {std::pair<std::string, std::string>{"--notes C4 --midi x.mid",

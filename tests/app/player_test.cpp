@@ -354,7 +354,7 @@ TEST(Player, ScoreMessagesLandOnTheirSamplesMergedWithLiveOnes) {
 }
 
 // Finished once the score's last message is played and no key sounds: here all sound off at
-// 0.05 s (the keys fade in 5 ms, and a fading key no longer counts).
+// 0.05 s, sample 2400 of block 9, and the keys' 5 ms fade, which ends in block 10.
 TEST(Player, FinishedOnceTheScoreIsPlayedAndSilent) {
   constexpr int kFrames = 256;
   const TimedMessage score[] = {
@@ -365,7 +365,8 @@ TEST(Player, FinishedOnceTheScoreIsPlayedAndSilent) {
   EXPECT_FALSE(player.status().finished);
   player.setScore(score);
   std::vector<float> interleaved(2 * kFrames);
-  const long last = std::lround(0.05 * kRate) / kFrames;  // the block that holds all sound off
+  const long last = std::lround(0.055 * kRate) / kFrames;  // the block in which the fade ends
+  ASSERT_EQ(last, std::lround(0.05 * kRate) / kFrames + 1);
   for (long b = 0; b <= last; ++b) {
     EXPECT_FALSE(player.status().finished) << "block " << b;
     player.render(interleaved.data(), kFrames, kNow);
@@ -376,6 +377,54 @@ TEST(Player, FinishedOnceTheScoreIsPlayedAndSilent) {
   Player live(synth, midi, nullptr, kRate, kFrames);
   live.render(interleaved.data(), kFrames, kNow);
   EXPECT_FALSE(live.status().finished);
+}
+
+// With endRecording (hamiltone-play --midi/--notes, which then exits), the recording ends with the
+// block in which the score finished — its last key faded out — whatever comes after it: the same
+// file in every run at the same block size. It went on until the main thread noticed the end (a
+// 250 ms poll), so that two runs of one score differed in their length of silence.
+TEST(Player, TheRecordingEndsWithTheScore) {
+  constexpr int kFrames = 256;
+  const TimedMessage score[] = {
+      {0.0, {0x90, 48, 100}}, {0.01, {0x80, 48, 0}}, {0.05, {0xB0, 120, 0}}};
+  Synth synth = prepared({pianoKeys(48, 52)});
+  SpscQueue<StampedMessage> midi(16);
+  SpscQueue<float> record(1 << 16);
+  Player player(synth, midi, &record, kRate, kFrames);
+  player.setScore(score, true);
+  std::vector<float> interleaved(2 * kFrames), rendered;
+  long blocks = 0;
+  for (; blocks < 100 && !player.status().finished; ++blocks) {
+    player.render(interleaved.data(), kFrames, kNow);
+    rendered.insert(rendered.end(), interleaved.begin(), interleaved.end());
+  }
+  ASSERT_TRUE(player.status().finished);
+  // All sound off at 0.05 s and its 5 ms fade are in the recording, the fade's end in its last
+  // block.
+  EXPECT_EQ(blocks, std::lround(0.055 * kRate) / kFrames + 1);
+  for (int b = 0; b < 10; ++b) player.render(interleaved.data(), kFrames, kNow);
+  std::vector<float> recorded(rendered.size() + 1);
+  recorded.resize(record.pop(recorded.data(), recorded.size()));
+  EXPECT_EQ(recorded, rendered);
+}
+
+// A score with nothing in it — a valid MIDI file with no channel message, only meta events — is
+// played to its end at once. It was taken for no score at all: hamiltone-play --midi on such a
+// file played silence forever, listening to no MIDI input and saying nothing.
+TEST(Player, AnEmptyScoreIsFinishedOnceTheKeysAreSilent) {
+  constexpr int kFrames = 256;
+  Synth synth = prepared({pianoKeys(48, 52)});
+  SpscQueue<StampedMessage> midi(16);
+  Player player(synth, midi, nullptr, kRate, kFrames);
+  player.setScore({});
+  std::vector<float> interleaved(2 * kFrames);
+  // A key played live keeps it from finishing while it sounds.
+  ASSERT_TRUE(midi.push({before(100), {0x90, 48, 100}}));
+  player.render(interleaved.data(), kFrames, kNow);
+  EXPECT_FALSE(player.status().finished);
+  ASSERT_TRUE(midi.push({before(100), {0xB0, 120, 0}}));  // all sound off
+  for (int b = 0; b < 4; ++b) player.render(interleaved.data(), kFrames, kNow);
+  EXPECT_TRUE(player.status().finished);
 }
 
 }  // namespace

@@ -416,6 +416,45 @@ TEST_F(JackPlay, ALostServerEndsThePlayerWithTheRecordingComplete) {
   }
 }
 
+// The JACK server's buffer size changed while playing (jack_bufsize; PipeWire changes its quantum
+// by itself): RtAudio's stream cannot follow — it calls the player no more and reports only a
+// warning — and its stopStream() waits for a callback that never comes. The player played on in
+// silence, saying nothing, and hung on Ctrl-C with the recording lost (its temporary left); now it
+// says why and exits 3 with the recording complete, as when the server goes away.
+TEST_F(JackPlay, ABufferSizeChangeEndsThePlayerWithTheRecordingComplete) {
+  if (!onPath("jackd") || !onPath("jack_lsp") || !onPath("jack_bufsize"))
+    GTEST_SKIP() << "jackd and jack_bufsize (Debian's jackd2) are not installed";
+  ASSERT_NO_FATAL_FAILURE(startServer(false));
+  ASSERT_NO_FATAL_FAILURE(
+      startPlayer({"--preset", HAMILTONE_SOURCE_DIR "/presets/paper-c3-string.toml"}));
+  std::this_thread::sleep_for(500ms);  // something to record
+  std::optional<Child> bufsize;
+  spawn(bufsize, {"jack_bufsize", std::to_string(2 * kPeriod)}, "bufsize");
+  ASSERT_EQ(bufsize->wait(10.0), 0) << slurp(dir_ / "bufsize.err");
+  expectEndedWithTheRecording(player_, dir_, 3, "the JACK server's buffer size changed", 1);
+}
+
+// Stopped while its callback is busy — 60 keys struck at once on one thread, more than a period's
+// work on a small machine: RtAudio's stopStream() lets the callback finish before JACK cancels its
+// thread. Cancelled inside the player's render (stopping with abortStream(), which does not
+// wait), the program terminated ("terminate called without an active exception"): no message,
+// no recording, its temporary left.
+TEST_F(JackPlay, StoppingWhileTheCallbackIsBusyCompletesTheRecording) {
+  if (!onPath("jackd") || !onPath("jack_lsp"))
+    GTEST_SKIP() << "jackd (Debian's jackd2) is not installed";
+  std::string chord;
+  for (int note = 30; note < 90; ++note) {
+    if (!chord.empty()) chord += ',';
+    chord += std::to_string(note) + ":100:10";
+  }
+  ASSERT_NO_FATAL_FAILURE(startServer(false));
+  ASSERT_NO_FATAL_FAILURE(startPlayer({"--preset", HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml",
+                                       "--threads", "1", "--notes", chord}));
+  std::this_thread::sleep_for(1s);
+  player_->signal(SIGINT);
+  expectEndedWithTheRecording(player_, dir_, 0, "stopped by SIGINT", 1);
+}
+
 // Recording onto a disk that fills (a 64 KiB tmpfs: 0.23 s of 24-bit stereo at 48 kHz): the
 // player says the recording stopped, plays on, and on SIGINT keeps the WAV up to the error and
 // exits 1 — where it aborted (exit 134) and left its temporary.
@@ -502,6 +541,15 @@ TEST_F(JackPlay, NotesPlayOnPitchAtTheServersRateAndEnd) {
   }
 }
 
+// A format 0 file of `track` at 480 ticks a quarter, written to `path`; returns `path`.
+fs::path writeMidi(const fs::path& path, const hamiltone::testing::TrackWriter& track) {
+  const hamiltone::testing::Bytes bytes = hamiltone::testing::midiFile(0, 480, {track});
+  std::ofstream(path, std::ios::binary)
+      .write(reinterpret_cast<const char*>(bytes.data()),
+             static_cast<std::streamsize>(bytes.size()));
+  return path;
+}
+
 // --midi FILE: played live from the stream's first sample, its events on their samples (the file's
 // note at 0.5 s starts there, to the hammer's few milliseconds, whatever the wall clock did), and
 // the player ends by itself, exit 0, after the last note died away.
@@ -512,11 +560,7 @@ TEST_F(JackPlay, MidiFilePlaysOnItsSamplesAndEnds) {
   // 480 ticks a quarter at the default 120 bpm: a tick is 1/960 s. C4 from 0.5 s to 2 s.
   TrackWriter track;
   track.event(0, {0xC0, 0}).event(480, {0x90, 60, 90}).event(1440, {0x80, 60, 0}).endOfTrack(0);
-  const fs::path midi = dir_ / "c4.mid";
-  const hamiltone::testing::Bytes bytes = hamiltone::testing::midiFile(0, 480, {track});
-  std::ofstream(midi, std::ios::binary)
-      .write(reinterpret_cast<const char*>(bytes.data()),
-             static_cast<std::streamsize>(bytes.size()));
+  const fs::path midi = writeMidi(dir_ / "c4.mid", track);
   ASSERT_NO_FATAL_FAILURE(startServer(false));
   const std::optional<int> code = playToTheEnd(
       {"--preset", HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml", "--midi", midi.string()});
@@ -532,6 +576,34 @@ TEST_F(JackPlay, MidiFilePlaysOnItsSamplesAndEnds) {
   EXPECT_LT(at, 24000 + 480) << "the note starts " << (at - 24000) / kRate << " s late";
   EXPECT_NEAR(off, 0.0, 3.0);
   EXPECT_LT(x.size(), static_cast<size_t>(10 * kRate));  // it ended after the tail, not later
+}
+
+// A score whose notes no preset plays (the piano's keys are A0 … C8) sounds nothing: the player
+// says so, naming the notes, as hamiltone-render does, where it "played --notes to the end" in
+// silence without a word; and a MIDI file with no note at all (only meta events) is played to its
+// end at once with a warning, where the player played silence forever.
+TEST_F(JackPlay, WarnsOfAScoreThatSoundsNothing) {
+  if (!onPath("jackd") || !onPath("jack_lsp"))
+    GTEST_SKIP() << "jackd (Debian's jackd2) is not installed";
+  using hamiltone::testing::TrackWriter;
+  TrackWriter track;
+  track.endOfTrack(0);
+  const fs::path midi = writeMidi(dir_ / "empty.mid", track);
+  ASSERT_NO_FATAL_FAILURE(startServer(false));
+  const std::string piano = HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml";
+  for (const auto& [score, mention] :
+       {std::pair<std::vector<std::string>, std::string>{
+            {"--notes", "5:100:0.1, A4:80:0.1, 120:100:0.1"},
+            "warning: no preset plays MIDI note(s) 5 120; they are silent"},
+        {{"--midi", midi.string()}, "warning: --midi " + midi.string() + " has no note to play"}}) {
+    std::vector<std::string> args = {"--quiet", "--preset", piano};
+    args.insert(args.end(), score.begin(), score.end());
+    const std::optional<int> code = playToTheEnd(args);
+    const std::string err = slurp(dir_ / "player.err");
+    EXPECT_EQ(code, 0) << err;
+    EXPECT_NE(err.find(mention), std::string::npos) << err;
+    EXPECT_NE(err.find("to the end"), std::string::npos) << err;
+  }
 }
 
 // No MIDI input asked for: a warning naming the ports there are and how to choose one. A port
