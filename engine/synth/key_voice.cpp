@@ -64,13 +64,14 @@ void KeyVoice::strikeNow(double velocity) noexcept {
   std::visit([velocity](auto& v) { v.noteOn(velocity); }, voice_);
 }
 
-void KeyVoice::release(double damperScale) noexcept {
+void KeyVoice::release(double damperScale, double contact) noexcept {
   if (pending()) {
     releasePending_ = true;
     damperScale_ = damperScale;
+    contact_ = contact;
     return;
   }
-  std::visit([damperScale](auto& v) { v.release(damperScale); }, voice_);
+  std::visit([damperScale, contact](auto& v) { v.release(damperScale, contact); }, voice_);
 }
 
 void KeyVoice::fadeOut() noexcept {
@@ -110,7 +111,7 @@ void KeyVoice::process(size_t frames, double gain) noexcept {
     if (!fading() && pending()) {  // the fade is over (or its voices fell silent): strike
       strikeNow(pendingVelocity_);
       pendingVelocity_ = -1.0;
-      if (releasePending_) release(damperScale_);
+      if (releasePending_) release(damperScale_, contact_);
       releasePending_ = false;
     }
     const bool wasFading = fading();

@@ -28,8 +28,8 @@ class KeyVoice {
   // ends, from rest (the note-on is pending until then).
   void strike(double velocity, long order) noexcept;
   // The damper falls (on a pending strike: right after it), its T60 the patch's times
-  // `damperScale`.
-  void release(double damperScale = 1.0) noexcept;
+  // `damperScale`, touching the strings with `contact` of its loss (0 … 1: the half-pedal).
+  void release(double damperScale = 1.0, double contact = 1.0) noexcept;
   void fadeOut() noexcept;  // stolen or silenced: fades over kFadeS, then frees itself
   void setBend(double semitones) noexcept;
 
@@ -54,7 +54,9 @@ class KeyVoice {
   double fundamentalHz() const;
 
   bool down = false;       // the key is held
-  bool sustained = false;  // released while the pedal was down: waits for the pedal to lift
+  // Released while the pedal (CC64) held its damper off the strings, wholly or partly: its damper
+  // follows the pedal until the pedal is fully up.
+  bool sustained = false;
 
  private:
   void render(std::span<float> left, std::span<float> right, double gain) noexcept;
@@ -67,7 +69,7 @@ class KeyVoice {
   int fadeSamples_ = 1, fadeLeft_ = 0;
   double pendingVelocity_ = -1.0;  // < 0: none
   bool releasePending_ = false;    // released before its pending strike
-  double damperScale_ = 1.0;       // the pending release's
+  double damperScale_ = 1.0, contact_ = 1.0;  // the pending release's
   long order_ = 0;
   double envelope_ = 0.0, loudest_ = 0.0, envelopeDecay_ = 0.0;  // loudest_: since the strike
   long sinceStrike_ = 0, attackSamples_ = 0;

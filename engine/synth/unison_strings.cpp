@@ -19,8 +19,8 @@ void UnisonStrings::noteOn(double velocity) noexcept {
   for (StringVoice& s : strings_) s.noteOn(velocity);
 }
 
-void UnisonStrings::release(double damperScale) noexcept {
-  for (StringVoice& s : strings_) s.release(damperScale);
+void UnisonStrings::release(double damperScale, double contact) noexcept {
+  for (StringVoice& s : strings_) s.release(damperScale, contact);
 }
 
 void UnisonStrings::setBend(double semitones) noexcept {

@@ -18,7 +18,7 @@ class UnisonStrings {
   void reset() noexcept;
 
   void noteOn(double velocity) noexcept;
-  void release(double damperScale) noexcept;
+  void release(double damperScale, double contact) noexcept;
   void setBend(double semitones) noexcept;
   void setQuietFloor(double floor) noexcept;  // each string's: the caller shares it among them
 

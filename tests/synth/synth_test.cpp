@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <vector>
 
@@ -55,6 +56,84 @@ TEST(Synth, DamperScaleLengthensTheDecayOfReleasedKeys) {
   synth.setDamperScale(1.0);
   render(synth, {{0.0, on(50)}, {0.1, off(50)}}, 1.1, 256);
   EXPECT_FALSE(synth.voice(0, 50)->sounding());
+}
+
+// The decay rate of a key, dB/s, from the RMS of two 50 ms windows of the take (seconds).
+double decayDbPerS(const Take& take, double from, double to) {
+  auto rms = [&](double t) {
+    const size_t a = std::lround(t * kRate), b = std::lround((t + 0.05) * kRate);
+    double sum = 0.0;
+    for (size_t i = a; i < b; ++i) sum += double(take.left[i]) * take.left[i];
+    return std::sqrt(sum / double(b - a));
+  };
+  return 20.0 * std::log10(rms(from) / rms(to)) / (to - from);
+}
+
+// A key released at 0.2 s under the pedal at `value` (none: no CC64 at all); `held`: never
+// released. The damper T60 is 1 s (60 dB/s) so that even fully damped the key stays well above
+// roundoff over the measurement; the voices never free themselves, as references. Struck softly
+// (40): at 100 the string's tension modulation moves energy between its partials enough to bend
+// the held key's measured decay (1.2 dB/s instead of its partials' 7 or so).
+Take releasedUnderPedal(int value, bool held = false) {
+  Instrument piano = pianoKeys(48, 48);
+  piano.keys[0].patch.damperT60 = 1.0;
+  Synth synth = prepared({piano}, 256, false);
+  std::vector<TimedMessage> score;
+  if (value >= 0) score.push_back({0.0, cc(64, value)});
+  score.push_back({0.0, on(48, 40)});
+  if (!held) score.push_back({0.2, off(48)});
+  return render(synth, score, 1.0, 256);
+}
+
+// Half-pedalling: the decay rate of a released key falls monotonically with CC64 from the damped
+// one (0, and the pedal's free play up to 20: bit for bit a key released without any pedal) to
+// the undamped one (127, and from 100: bit for bit a key still held). In between the damper adds
+// damperContact() of its 60 dB/s; the key's own decay is the same throughout, so the measured
+// rate is the held key's plus that share, within 1.5 dB/s (the 50 ms windows over a 130 Hz
+// string's partials, decaying at several rates, are not a pure exponential).
+TEST(Synth, HalfPedalSetsTheDecayBetweenDampedAndUndamped) {
+  const Take released = releasedUnderPedal(-1), held = releasedUnderPedal(-1, true);
+  EXPECT_EQ(releasedUnderPedal(0).left, released.left);
+  EXPECT_EQ(releasedUnderPedal(20).left, released.left);
+  EXPECT_EQ(releasedUnderPedal(127).left, held.left);
+  EXPECT_EQ(releasedUnderPedal(100).left, held.left);
+  const double damped = decayDbPerS(released, 0.5, 0.8), free = decayDbPerS(held, 0.5, 0.8);
+  EXPECT_NEAR(damped - free, 60.0, 3.0);
+  double previous = INFINITY;
+  for (int value : {0, 32, 64, 96, 127}) {
+    const double rate = decayDbPerS(releasedUnderPedal(value), 0.5, 0.8);
+    std::printf("CC64 %3d: contact %.3f, decay %.1f dB/s\n", value, Synth::damperContact(value),
+                rate);
+    EXPECT_LT(rate, previous) << "CC64 " << value;
+    EXPECT_NEAR(rate, free + Synth::damperContact(value) * (damped - free), 1.5) << value;
+    previous = rate;
+  }
+  const double half = decayDbPerS(releasedUnderPedal(64), 0.5, 0.8);
+  EXPECT_GT(half, free + 10.0);
+  EXPECT_LT(half, damped - 10.0);
+}
+
+// The pedal moved while a released key rings changes its decay from that moment: lifted fully
+// (127) it holds, half down (64) it decays at the half pedal's rate, down (0) at the damper's. The
+// loss changes between two steps, so the signal has no step: no sample-to-sample jump after the
+// changes larger than the key's own largest before them.
+TEST(Synth, MovingThePedalWhileAKeyRingsChangesItsDecayWithoutAClick) {
+  Instrument piano = pianoKeys(48, 48);
+  piano.keys[0].patch.damperT60 = 1.0;
+  Synth synth = prepared({piano}, 256, false);
+  const Take take = render(
+      synth, {{0.0, cc(64, 127)}, {0.0, on(48)}, {0.1, off(48)}, {0.6, cc(64, 64)}, {1.0, cc(64, 0)}},
+      1.4, 256);
+  const double sustained = decayDbPerS(take, 0.3, 0.5), half = decayDbPerS(take, 0.7, 0.9),
+               damped = decayDbPerS(take, 1.1, 1.3);
+  EXPECT_LT(sustained, half - 10.0);
+  EXPECT_LT(half, damped - 10.0);
+  float before = 0.0f, after = 0.0f;
+  for (size_t i = 12000; i < take.left.size(); ++i) {  // from 0.25 s; the change at 0.6 s
+    float& largest = i < 28800 ? before : after;
+    largest = std::max(largest, std::abs(take.left[i] - take.left[i - 1]));
+  }
+  EXPECT_LE(after, before);
 }
 
 TEST(Synth, RestrikingASoundingKeyReexcitesTheSameVoice) {
