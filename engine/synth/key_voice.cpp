@@ -45,7 +45,7 @@ void KeyVoice::prepare(const Instrument& instrument, int note, double sampleRate
   pendingVelocity_ = -1.0;
   releasePending_ = false;
   envelope_ = loudest_ = 0.0;
-  down = sustained = false;
+  down = sustained = caught = false;
 }
 
 void KeyVoice::strike(double velocity, long order) noexcept {
@@ -78,7 +78,7 @@ void KeyVoice::fadeOut() noexcept {
   if (sounding() && !fading()) fadeLeft_ = fadeSamples_;
   pendingVelocity_ = -1.0;
   releasePending_ = false;
-  down = sustained = false;
+  down = sustained = caught = false;
 }
 
 void KeyVoice::setBend(double semitones) noexcept {

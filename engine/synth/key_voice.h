@@ -53,10 +53,13 @@ class KeyVoice {
   int guardEvents() const;
   double fundamentalHz() const;
 
-  bool down = false;       // the key is held
+  bool down = false;  // the key is held
   // Released while the pedal (CC64) held its damper off the strings, wholly or partly: its damper
   // follows the pedal until the pedal is fully up.
   bool sustained = false;
+  // Held when the sostenuto pedal (CC66) went down: its damper stays off the strings, whatever
+  // the sustain pedal does, until the sostenuto pedal lifts.
+  bool caught = false;
 
  private:
   void render(std::span<float> left, std::span<float> right, double gain) noexcept;
@@ -67,8 +70,8 @@ class KeyVoice {
   size_t frames_ = 0;  // written to the outputs by the last process()
   double panLeft_ = 1.0, panRight_ = 1.0;
   int fadeSamples_ = 1, fadeLeft_ = 0;
-  double pendingVelocity_ = -1.0;  // < 0: none
-  bool releasePending_ = false;    // released before its pending strike
+  double pendingVelocity_ = -1.0;             // < 0: none
+  bool releasePending_ = false;               // released before its pending strike
   double damperScale_ = 1.0, contact_ = 1.0;  // the pending release's
   long order_ = 0;
   double envelope_ = 0.0, loudest_ = 0.0, envelopeDecay_ = 0.0;  // loudest_: since the strike

@@ -68,6 +68,7 @@ void Synth::prepare(std::vector<Instrument> instruments, const SynthSetup& setup
   program_ = 0;
   std::fill(std::begin(downProgram_), std::end(downProgram_), -1);
   contact_ = 1.0;
+  sostenuto_ = false;
   bend_ = 0.0;
   strikes_ = steals_ = 0;
   loudestSteal_ = 0.0;
@@ -130,7 +131,8 @@ bool Synth::stealOne() noexcept {
   auto better = [&](const KeyVoice& v) {
     if (!victim) return true;
     if (v.level() != victim->level()) return v.level() < victim->level();
-    const bool free = !v.down && !v.sustained, victimFree = !victim->down && !victim->sustained;
+    const bool free = !v.down && !v.sustained && !v.caught,
+               victimFree = !victim->down && !victim->sustained && !victim->caught;
     if (free != victimFree) return free;
     return v.order() < victim->order();
   };
@@ -166,6 +168,10 @@ void Synth::noteOff(int note) noexcept {
   downProgram_[note] = -1;
   if (!voice || !voice->down) return;
   voice->down = false;
+  if (voice->caught) {  // the sostenuto pedal holds its damper up
+    voice->sustained = contact_ < 1.0;
+    return;
+  }
   if (contact_ < 1.0) {
     voice->sustained = true;
     if (contact_ > 0.0) voice->release(damperScale_, contact_);  // a half pedal
@@ -185,12 +191,35 @@ void Synth::setSustain(int value) noexcept {
   for (auto& keys : voices_)
     for (KeyVoice& v : keys) {
       if (!v.sustained) continue;
-      if (contact < 1.0) {
+      if (v.caught) {  // its damper is the sostenuto's until that lifts
+        v.sustained = contact < 1.0;
+      } else if (contact < 1.0) {
         v.release(damperScale_, contact);
       } else {
         v.sustained = false;
         v.release(damperScale_);
       }
+    }
+}
+
+// Going down, it catches the dampers of the keys held then; lifting, it lets them fall on the keys
+// released since (onto the sustain pedal's contact for those it also holds).
+void Synth::setSostenuto(bool down) noexcept {
+  if (down == sostenuto_) return;
+  sostenuto_ = down;
+  for (auto& keys : voices_)
+    for (KeyVoice& v : keys) {
+      if (down) {
+        v.caught = v.down;
+        continue;
+      }
+      if (!v.caught) continue;
+      v.caught = false;
+      if (v.down) continue;
+      if (!v.sustained)
+        v.release(damperScale_);
+      else if (contact_ > 0.0)
+        v.release(damperScale_, contact_);
     }
 }
 
@@ -223,6 +252,9 @@ void Synth::handle(const MidiMessage& m) noexcept {
         case midi::sustainPedal:
           setSustain(m.data2 & 0x7F);
           break;
+        case midi::sostenutoPedal:
+          setSostenuto((m.data2 & 0x7F) >= 64);
+          break;
         case midi::volume: {
           const double v = (m.data2 & 0x7F) / 127.0;
           master_.setVolume(v * v);
@@ -234,6 +266,7 @@ void Synth::handle(const MidiMessage& m) noexcept {
         case midi::resetControllers:
           setBend(0.0);
           setSustain(0);
+          setSostenuto(false);
           break;
         case midi::allNotesOff:
           for (int note = 0; note < 128; ++note) noteOff(note);

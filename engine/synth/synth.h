@@ -42,9 +42,11 @@ struct SynthSetup {
 //   voice (its strings keep vibrating, as on a piano); CC64 sustain, continuous (half-pedalling,
 //   damperContact()): the dampers of the keys released while it is down touch their strings with
 //   the pedal's contact, from fully on (0…20, as with no pedal) to fully lifted (100…127), and
-//   follow it until it is fully up; CC7 volume, gain
+//   follow it until it is fully up; CC66 sostenuto, 64…127 down: the keys held as it goes down
+//   keep their dampers off the strings after their release until it lifts, keys struck later do
+//   not; CC7 volume, gain
 //   (value/127)², smoothed over 10 ms; CC120 all sound off: every voice fades out in 5 ms;
-//   CC121 reset controllers: bend centred, pedal up; CC123 all notes off: as a note-off for every
+//   CC121 reset controllers: bend centred, pedals up; CC123 all notes off: as a note-off for every
 //   held key (the pedal still sustains them); pitch bend ±bend_range_semitones of the instrument
 //   (strings retension, plates do not bend); program change n selects instrument n (ignored
 //   beyond the last), sounding notes ring on in the old one.
@@ -97,7 +99,8 @@ class Synth {
   void render(std::span<float> left, std::span<float> right) noexcept;
   void noteOn(int note, int velocity) noexcept;
   void noteOff(int note) noexcept;
-  void setSustain(int value) noexcept;  // CC64
+  void setSustain(int value) noexcept;    // CC64
+  void setSostenuto(bool down) noexcept;  // CC66
   void setBend(double fraction) noexcept;
   void allSoundOff() noexcept;
   KeyVoice* keyVoice(int program, int note);
@@ -119,8 +122,9 @@ class Synth {
   int maxBlock_ = 0;
   int program_ = 0, polyphonyOverride_ = 0;
   int downProgram_[128];  // which instrument's voice a held note struck (−1: none)
+  bool sostenuto_ = false;
   double contact_ = 1.0;  // of the dampers of the keys released under the pedal (damperContact)
-  double bend_ = 0.0;  // −1 … 1 of the range
+  double bend_ = 0.0;     // −1 … 1 of the range
   double damperScale_ = 1.0;
   long strikes_ = 0;
   long steals_ = 0;

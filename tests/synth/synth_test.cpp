@@ -122,8 +122,9 @@ TEST(Synth, MovingThePedalWhileAKeyRingsChangesItsDecayWithoutAClick) {
   piano.keys[0].patch.damperT60 = 1.0;
   Synth synth = prepared({piano}, 256, false);
   const Take take = render(
-      synth, {{0.0, cc(64, 127)}, {0.0, on(48)}, {0.1, off(48)}, {0.6, cc(64, 64)}, {1.0, cc(64, 0)}},
-      1.4, 256);
+      synth,
+      {{0.0, cc(64, 127)}, {0.0, on(48)}, {0.1, off(48)}, {0.6, cc(64, 64)}, {1.0, cc(64, 0)}}, 1.4,
+      256);
   const double sustained = decayDbPerS(take, 0.3, 0.5), half = decayDbPerS(take, 0.7, 0.9),
                damped = decayDbPerS(take, 1.1, 1.3);
   EXPECT_LT(sustained, half - 10.0);
@@ -134,6 +135,29 @@ TEST(Synth, MovingThePedalWhileAKeyRingsChangesItsDecayWithoutAClick) {
     largest = std::max(largest, std::abs(take.left[i] - take.left[i - 1]));
   }
   EXPECT_LE(after, before);
+}
+
+// Sostenuto (CC66): 48, held as the pedal goes down, rings on after its release (its own T60 of
+// 8 s: after 0.5 s within a few dB of its peak); 52, struck after, is damped at its release (T60
+// 0.25 s: 120 dB down in 0.5 s). Lifting the pedal damps 48 too. Levels from the keys' rendered
+// output (KeyVoice::level).
+TEST(Synth, SostenutoHoldsOnlyTheKeysHeldAsItGoesDown) {
+  Synth synth = prepared({pianoKeys(48, 52)}, 256, false);
+  render(synth, {{0.0, on(48)}, {0.1, cc(66, 127)}, {0.2, on(52)}, {0.3, off(48)}, {0.3, off(52)}},
+         0.8, 256);
+  EXPECT_GT(synth.voice(0, 48)->level(), 0.3);
+  EXPECT_LT(synth.voice(0, 52)->level(), 1e-3);
+  EXPECT_TRUE(synth.voice(0, 48)->caught);
+  // A key struck and released under the sustain pedal meanwhile is the sustain pedal's alone.
+  render(synth, {{0.0, cc(64, 127)}, {0.0, on(50)}, {0.1, off(50)}, {0.2, cc(64, 0)}}, 0.8, 256);
+  EXPECT_GT(synth.voice(0, 48)->level(), 0.2);
+  EXPECT_LT(synth.voice(0, 50)->level(), 1e-3);
+  render(synth, {{0.0, cc(66, 0)}}, 0.5, 256);
+  EXPECT_FALSE(synth.voice(0, 48)->caught);
+  EXPECT_LT(synth.voice(0, 48)->level(), 1e-3);
+  // Reset controllers lifts it too.
+  render(synth, {{0.0, on(49)}, {0.05, cc(66, 127)}, {0.1, cc(121, 0)}, {0.15, off(49)}}, 0.7, 256);
+  EXPECT_LT(synth.voice(0, 49)->level(), 1e-3);
 }
 
 TEST(Synth, RestrikingASoundingKeyReexcitesTheSameVoice) {

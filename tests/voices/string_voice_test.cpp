@@ -213,7 +213,7 @@ TEST(StringVoice, MovingTheDamperEveryBlockOnlyRemovesEnergy) {
   bool grew = false;
   int block = 0;
   const bool finite = play(voice, 0.5, 48000.0, [&] {
-    voice.release(1.0, 0.5 + 0.5 * std::sin(0.7 * block++));  // 0 … 1, a new value every block
+    voice.release(1.0, 0.5 + 0.5 * std::sin(0.7 * block++));   // 0 … 1, a new value every block
     grew = grew || voice.energy() > previous * (1.0 + 1e-12);  // roundoff aside
     previous = voice.energy();
   });
