@@ -48,20 +48,24 @@ void KeyVoice::prepare(const Instrument& instrument, int note, double sampleRate
   down = sustained = caught = false;
 }
 
-void KeyVoice::strike(double velocity, long order) noexcept {
+void KeyVoice::strike(double velocity, long order, bool unaCorda) noexcept {
   order_ = order;
   sinceStrike_ = 0;
   if (fading() || pending()) {
     pendingVelocity_ = velocity;
+    pendingUnaCorda_ = unaCorda;
     releasePending_ = false;
     return;
   }
-  strikeNow(velocity);
+  strikeNow(velocity, unaCorda);
 }
 
-void KeyVoice::strikeNow(double velocity) noexcept {
+void KeyVoice::strikeNow(double velocity, bool unaCorda) noexcept {
   loudest_ = envelope_;
-  std::visit([velocity](auto& v) { v.noteOn(velocity); }, voice_);
+  if (UnisonStrings* strings = std::get_if<UnisonStrings>(&voice_))
+    strings->noteOn(velocity, unaCorda);
+  else
+    std::get<PlateVoice>(voice_).noteOn(velocity);
 }
 
 void KeyVoice::release(double damperScale, double contact) noexcept {
@@ -109,7 +113,7 @@ void KeyVoice::process(size_t frames, double gain) noexcept {
   size_t done = 0;
   while (done < frames) {
     if (!fading() && pending()) {  // the fade is over (or its voices fell silent): strike
-      strikeNow(pendingVelocity_);
+      strikeNow(pendingVelocity_, pendingUnaCorda_);
       pendingVelocity_ = -1.0;
       if (releasePending_) release(damperScale_, contact_);
       releasePending_ = false;

@@ -26,7 +26,8 @@ class KeyVoice {
 
   // 0 … 1. A sounding key is struck again where it is; a fading one is struck once its fade
   // ends, from rest (the note-on is pending until then).
-  void strike(double velocity, long order) noexcept;
+  // unaCorda: the soft pedal is down (UnisonStrings::noteOn; a plate ignores it).
+  void strike(double velocity, long order, bool unaCorda = false) noexcept;
   // The damper falls (on a pending strike: right after it), its T60 the patch's times
   // `damperScale`, touching the strings with `contact` of its loss (0 … 1: the half-pedal).
   void release(double damperScale = 1.0, double contact = 1.0) noexcept;
@@ -63,15 +64,16 @@ class KeyVoice {
 
  private:
   void render(std::span<float> left, std::span<float> right, double gain) noexcept;
-  void strikeNow(double velocity) noexcept;
+  void strikeNow(double velocity, bool unaCorda) noexcept;
 
   std::variant<UnisonStrings, PlateVoice> voice_;  // one voice type per instrument model
   std::vector<float> voiceLeft_, voiceRight_, mixLeft_, mixRight_, outLeft_, outRight_;
   size_t frames_ = 0;  // written to the outputs by the last process()
   double panLeft_ = 1.0, panRight_ = 1.0;
   int fadeSamples_ = 1, fadeLeft_ = 0;
-  double pendingVelocity_ = -1.0;             // < 0: none
-  bool releasePending_ = false;               // released before its pending strike
+  double pendingVelocity_ = -1.0;  // < 0: none
+  bool releasePending_ = false;    // released before its pending strike
+  bool pendingUnaCorda_ = false;
   double damperScale_ = 1.0, contact_ = 1.0;  // the pending release's
   long order_ = 0;
   double envelope_ = 0.0, loudest_ = 0.0, envelopeDecay_ = 0.0;  // loudest_: since the strike

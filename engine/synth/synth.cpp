@@ -68,7 +68,7 @@ void Synth::prepare(std::vector<Instrument> instruments, const SynthSetup& setup
   program_ = 0;
   std::fill(std::begin(downProgram_), std::end(downProgram_), -1);
   contact_ = 1.0;
-  sostenuto_ = false;
+  sostenuto_ = unaCorda_ = false;
   bend_ = 0.0;
   strikes_ = steals_ = 0;
   loudestSteal_ = 0.0;
@@ -156,7 +156,7 @@ void Synth::noteOn(int note, int velocity) noexcept {
     while (activeVoices() >= polyphony() && stealOne()) {
     }
   voice->setBend(bend_ * instruments_[program_].bendRange);
-  voice->strike(velocity / 127.0, ++strikes_);
+  voice->strike(velocity / 127.0, ++strikes_, unaCorda_);
   voice->down = true;
   voice->sustained = false;
   downProgram_[note] = program_;
@@ -255,6 +255,9 @@ void Synth::handle(const MidiMessage& m) noexcept {
         case midi::sostenutoPedal:
           setSostenuto((m.data2 & 0x7F) >= 64);
           break;
+        case midi::softPedal:
+          unaCorda_ = (m.data2 & 0x7F) >= 64;
+          break;
         case midi::volume: {
           const double v = (m.data2 & 0x7F) / 127.0;
           master_.setVolume(v * v);
@@ -267,6 +270,7 @@ void Synth::handle(const MidiMessage& m) noexcept {
           setBend(0.0);
           setSustain(0);
           setSostenuto(false);
+          unaCorda_ = false;
           break;
         case midi::allNotesOff:
           for (int note = 0; note < 128; ++note) noteOff(note);

@@ -44,7 +44,8 @@ struct SynthSetup {
 //   the pedal's contact, from fully on (0…20, as with no pedal) to fully lifted (100…127), and
 //   follow it until it is fully up; CC66 sostenuto, 64…127 down: the keys held as it goes down
 //   keep their dampers off the strings after their release until it lifts, keys struck later do
-//   not; CC7 volume, gain
+//   not; CC67 una corda, 64…127 down: keys struck meanwhile strike two strings of three
+//   (UnisonStrings::noteOn); CC7 volume, gain
 //   (value/127)², smoothed over 10 ms; CC120 all sound off: every voice fades out in 5 ms;
 //   CC121 reset controllers: bend centred, pedals up; CC123 all notes off: as a note-off for every
 //   held key (the pedal still sustains them); pitch bend ±bend_range_semitones of the instrument
@@ -122,7 +123,7 @@ class Synth {
   int maxBlock_ = 0;
   int program_ = 0, polyphonyOverride_ = 0;
   int downProgram_[128];  // which instrument's voice a held note struck (−1: none)
-  bool sostenuto_ = false;
+  bool sostenuto_ = false, unaCorda_ = false;
   double contact_ = 1.0;  // of the dampers of the keys released under the pedal (damperContact)
   double bend_ = 0.0;     // −1 … 1 of the range
   double damperScale_ = 1.0;

@@ -160,6 +160,50 @@ TEST(Synth, SostenutoHoldsOnlyTheKeysHeldAsItGoesDown) {
   EXPECT_LT(synth.voice(0, 49)->level(), 1e-3);
 }
 
+// Una corda (CC67): a three-string key struck with the soft pedal down strikes two of its strings
+// — the energy of two hammers' shares of three, so its level is about 20·log10(2/3) = −3.5 dB
+// (its amplitude, two strings of the same amplitude instead of three), within 1 dB (the strings'
+// cent of detuning beat differently); it stays on pitch. A key of one string is struck as ever, bit
+// for bit; the pedal up, three strings again.
+TEST(Synth, UnaCordaStrikesTwoStringsOfThree) {
+  Instrument piano = pianoKeys(57, 57);
+  piano.keys[0].unisons = 3;
+  piano.keys[0].detuneCents = 2.0;  // the strings at −1, 0 and +1 cent
+  piano.gainDb = -20.0;             // well under the master's limiter (0.98)
+  auto take = [&](bool soft) {
+    Synth synth = prepared({piano}, 256, false);
+    std::vector<TimedMessage> score;
+    if (soft) score.push_back({0.0, cc(67, 127)});
+    score.push_back({0.0, on(57, 40)});
+    return render(synth, score, 1.0, 256);
+  };
+  const Take full = take(false), soft = take(true);
+  auto rms = [](const Take& t) {
+    double sum = 0.0;
+    for (size_t i = 2400; i < 12000; ++i) sum += double(t.left[i]) * t.left[i];
+    return std::sqrt(sum / 9600.0);
+  };
+  const double db = 20.0 * std::log10(rms(soft) / rms(full));
+  std::printf("una corda: %.2f dB\n", db);
+  EXPECT_NEAR(db, 20.0 * std::log10(2.0 / 3.0), 1.0);
+  // On pitch: the three strings' mean is the note (the test string itself sounds about half a
+  // cent sharp of 220 Hz: its stiffness); the two struck are its middle and highest, 0 and +1
+  // cent, so the soft note is sharp of the full one by their mean, 0.5 cent (± 0.2: the
+  // zero-crossing count over 0.5 s).
+  auto cents = [](const Take& t) {
+    std::vector<double> x(t.left.begin() + 24000, t.left.end());
+    return testing::cents(testing::zeroCrossingFrequency(x, 1.0 / kRate), 220.0);
+  };
+  std::printf("three strings %+.2f cents, una corda %+.2f cents\n", cents(full), cents(soft));
+  EXPECT_NEAR(cents(full), 0.0, 1.0);
+  EXPECT_NEAR(cents(soft) - cents(full), 0.5, 0.2);
+  // One string: the pedal changes nothing.
+  Instrument one = pianoKeys(57, 57);
+  Synth a = prepared({one}, 256, false), b = prepared({one}, 256, false);
+  EXPECT_EQ(render(a, {{0.0, on(57)}}, 0.2, 256).left,
+            render(b, {{0.0, cc(67, 127)}, {0.0, on(57)}}, 0.2, 256).left);
+}
+
 TEST(Synth, RestrikingASoundingKeyReexcitesTheSameVoice) {
   Synth synth = prepared({pianoKeys(48, 48)});
   render(synth, {{0.0, on(48, 60)}}, 0.2, 64);
