@@ -18,8 +18,8 @@ struct MidiMessage {
 namespace midi {
 inline constexpr int noteOff = 0x80, noteOn = 0x90, polyPressure = 0xA0, controller = 0xB0,
                      program = 0xC0, channelPressure = 0xD0, pitchBend = 0xE0;
-inline constexpr int sustainPedal = 64, volume = 7, allSoundOff = 120, resetControllers = 121,
-                     allNotesOff = 123;
+inline constexpr int sustainPedal = 64, sostenutoPedal = 66, softPedal = 67, volume = 7,
+                     allSoundOff = 120, resetControllers = 121, allNotesOff = 123;
 }  // namespace midi
 
 // A message at a time in seconds from the start of a performance.

@@ -45,39 +45,44 @@ void KeyVoice::prepare(const Instrument& instrument, int note, double sampleRate
   pendingVelocity_ = -1.0;
   releasePending_ = false;
   envelope_ = loudest_ = 0.0;
-  down = sustained = false;
+  down = sustained = caught = false;
 }
 
-void KeyVoice::strike(double velocity, long order) noexcept {
+void KeyVoice::strike(double velocity, long order, bool unaCorda) noexcept {
   order_ = order;
   sinceStrike_ = 0;
   if (fading() || pending()) {
     pendingVelocity_ = velocity;
+    pendingUnaCorda_ = unaCorda;
     releasePending_ = false;
     return;
   }
-  strikeNow(velocity);
+  strikeNow(velocity, unaCorda);
 }
 
-void KeyVoice::strikeNow(double velocity) noexcept {
+void KeyVoice::strikeNow(double velocity, bool unaCorda) noexcept {
   loudest_ = envelope_;
-  std::visit([velocity](auto& v) { v.noteOn(velocity); }, voice_);
+  if (UnisonStrings* strings = std::get_if<UnisonStrings>(&voice_))
+    strings->noteOn(velocity, unaCorda);
+  else
+    std::get<PlateVoice>(voice_).noteOn(velocity);
 }
 
-void KeyVoice::release(double damperScale) noexcept {
+void KeyVoice::release(double damperScale, double contact) noexcept {
   if (pending()) {
     releasePending_ = true;
     damperScale_ = damperScale;
+    contact_ = contact;
     return;
   }
-  std::visit([damperScale](auto& v) { v.release(damperScale); }, voice_);
+  std::visit([damperScale, contact](auto& v) { v.release(damperScale, contact); }, voice_);
 }
 
 void KeyVoice::fadeOut() noexcept {
   if (sounding() && !fading()) fadeLeft_ = fadeSamples_;
   pendingVelocity_ = -1.0;
   releasePending_ = false;
-  down = sustained = false;
+  down = sustained = caught = false;
 }
 
 void KeyVoice::setBend(double semitones) noexcept {
@@ -108,9 +113,9 @@ void KeyVoice::process(size_t frames, double gain) noexcept {
   size_t done = 0;
   while (done < frames) {
     if (!fading() && pending()) {  // the fade is over (or its voices fell silent): strike
-      strikeNow(pendingVelocity_);
+      strikeNow(pendingVelocity_, pendingUnaCorda_);
       pendingVelocity_ = -1.0;
-      if (releasePending_) release(damperScale_);
+      if (releasePending_) release(damperScale_, contact_);
       releasePending_ = false;
     }
     const bool wasFading = fading();

@@ -26,10 +26,11 @@ class KeyVoice {
 
   // 0 … 1. A sounding key is struck again where it is; a fading one is struck once its fade
   // ends, from rest (the note-on is pending until then).
-  void strike(double velocity, long order) noexcept;
+  // unaCorda: the soft pedal is down (UnisonStrings::noteOn; a plate ignores it).
+  void strike(double velocity, long order, bool unaCorda = false) noexcept;
   // The damper falls (on a pending strike: right after it), its T60 the patch's times
-  // `damperScale`.
-  void release(double damperScale = 1.0) noexcept;
+  // `damperScale`, touching the strings with `contact` of its loss (0 … 1: the half-pedal).
+  void release(double damperScale = 1.0, double contact = 1.0) noexcept;
   void fadeOut() noexcept;  // stolen or silenced: fades over kFadeS, then frees itself
   void setBend(double semitones) noexcept;
 
@@ -53,12 +54,17 @@ class KeyVoice {
   int guardEvents() const;
   double fundamentalHz() const;
 
-  bool down = false;       // the key is held
-  bool sustained = false;  // released while the pedal was down: waits for the pedal to lift
+  bool down = false;  // the key is held
+  // Released while the pedal (CC64) held its damper off the strings, wholly or partly: its damper
+  // follows the pedal until the pedal is fully up.
+  bool sustained = false;
+  // Held when the sostenuto pedal (CC66) went down: its damper stays off the strings, whatever
+  // the sustain pedal does, until the sostenuto pedal lifts.
+  bool caught = false;
 
  private:
   void render(std::span<float> left, std::span<float> right, double gain) noexcept;
-  void strikeNow(double velocity) noexcept;
+  void strikeNow(double velocity, bool unaCorda) noexcept;
 
   std::variant<UnisonStrings, PlateVoice> voice_;  // one voice type per instrument model
   std::vector<float> voiceLeft_, voiceRight_, mixLeft_, mixRight_, outLeft_, outRight_;
@@ -67,7 +73,8 @@ class KeyVoice {
   int fadeSamples_ = 1, fadeLeft_ = 0;
   double pendingVelocity_ = -1.0;  // < 0: none
   bool releasePending_ = false;    // released before its pending strike
-  double damperScale_ = 1.0;       // the pending release's
+  bool pendingUnaCorda_ = false;
+  double damperScale_ = 1.0, contact_ = 1.0;  // the pending release's
   long order_ = 0;
   double envelope_ = 0.0, loudest_ = 0.0, envelopeDecay_ = 0.0;  // loudest_: since the strike
   long sinceStrike_ = 0, attackSamples_ = 0;

@@ -67,7 +67,8 @@ void Synth::prepare(std::vector<Instrument> instruments, const SynthSetup& setup
   maxBlock_ = setup.maxBlock;
   program_ = 0;
   std::fill(std::begin(downProgram_), std::end(downProgram_), -1);
-  sustain_ = false;
+  contact_ = 1.0;
+  sostenuto_ = unaCorda_ = false;
   bend_ = 0.0;
   strikes_ = steals_ = 0;
   loudestSteal_ = 0.0;
@@ -89,6 +90,13 @@ void Synth::setPolyphony(int voices) noexcept {
   polyphonyOverride_ = std::max(voices, 0);
   while (activeVoices() > polyphony() && stealOne()) {
   }
+}
+
+double Synth::damperContact(int value) noexcept {
+  constexpr int kFreePlay = 20, kLifted = 100;
+  if (value <= kFreePlay) return 1.0;
+  if (value >= kLifted) return 0.0;
+  return static_cast<double>(kLifted - value) / (kLifted - kFreePlay);
 }
 
 void Synth::setDamperScale(double scale) noexcept {
@@ -130,7 +138,8 @@ bool Synth::stealOne() noexcept {
   auto better = [&](const KeyVoice& v) {
     if (!victim) return true;
     if (v.level() != victim->level()) return v.level() < victim->level();
-    const bool free = !v.down && !v.sustained, victimFree = !victim->down && !victim->sustained;
+    const bool free = !v.down && !v.sustained && !v.caught,
+               victimFree = !victim->down && !victim->sustained && !victim->caught;
     if (free != victimFree) return free;
     return v.order() < victim->order();
   };
@@ -154,7 +163,7 @@ void Synth::noteOn(int note, int velocity) noexcept {
     while (activeVoices() >= polyphony() && stealOne()) {
     }
   voice->setBend(bend_ * instruments_[program_].bendRange);
-  voice->strike(velocity / 127.0, ++strikes_);
+  voice->strike(velocity / 127.0, ++strikes_, unaCorda_);
   voice->down = true;
   voice->sustained = false;
   downProgram_[note] = program_;
@@ -166,22 +175,59 @@ void Synth::noteOff(int note) noexcept {
   downProgram_[note] = -1;
   if (!voice || !voice->down) return;
   voice->down = false;
-  if (sustain_)
+  if (voice->caught) {  // the sostenuto pedal holds its damper up
+    voice->sustained = contact_ < 1.0;
+    return;
+  }
+  if (contact_ < 1.0) {
     voice->sustained = true;
-  else
+    if (contact_ > 0.0) voice->release(damperScale_, contact_);  // a half pedal
+  } else {
     voice->release(damperScale_);
+  }
 }
 
-void Synth::setSustain(bool down) noexcept {
-  if (down == sustain_) return;
-  sustain_ = down;
-  if (down) return;
+// The dampers of the keys released under the pedal follow it; those of the keys released while it
+// was up stay on their strings (as before the half pedal: pressing the pedal again does not revive
+// them), and a key released under the pedal leaves its care once the pedal is fully up. The loss
+// moves at the event, between two steps: a kink in the decay, never a step in the signal.
+void Synth::setSustain(int value) noexcept {
+  const double contact = damperContact(value);
+  if (contact == contact_) return;
+  contact_ = contact;
   for (auto& keys : voices_)
-    for (KeyVoice& v : keys)
-      if (v.sustained) {
+    for (KeyVoice& v : keys) {
+      if (!v.sustained) continue;
+      if (v.caught) {  // its damper is the sostenuto's until that lifts
+        v.sustained = contact < 1.0;
+      } else if (contact < 1.0) {
+        v.release(damperScale_, contact);
+      } else {
         v.sustained = false;
         v.release(damperScale_);
       }
+    }
+}
+
+// Going down, it catches the dampers of the keys held then; lifting, it lets them fall on the keys
+// released since (onto the sustain pedal's contact for those it also holds).
+void Synth::setSostenuto(bool down) noexcept {
+  if (down == sostenuto_) return;
+  sostenuto_ = down;
+  for (auto& keys : voices_)
+    for (KeyVoice& v : keys) {
+      if (down) {
+        v.caught = v.down;
+        continue;
+      }
+      if (!v.caught) continue;
+      v.caught = false;
+      if (v.down) continue;
+      if (!v.sustained)
+        v.release(damperScale_);
+      else if (contact_ > 0.0)
+        v.release(damperScale_, contact_);
+    }
 }
 
 void Synth::setBend(double fraction) noexcept {
@@ -211,7 +257,13 @@ void Synth::handle(const MidiMessage& m) noexcept {
     case midi::controller:
       switch (m.data1) {
         case midi::sustainPedal:
-          setSustain(m.data2 >= 64);
+          setSustain(m.data2 & 0x7F);
+          break;
+        case midi::sostenutoPedal:
+          setSostenuto((m.data2 & 0x7F) >= 64);
+          break;
+        case midi::softPedal:
+          unaCorda_ = (m.data2 & 0x7F) >= 64;
           break;
         case midi::volume: {
           const double v = (m.data2 & 0x7F) / 127.0;
@@ -223,7 +275,9 @@ void Synth::handle(const MidiMessage& m) noexcept {
           break;
         case midi::resetControllers:
           setBend(0.0);
-          setSustain(false);
+          setSustain(0);
+          setSostenuto(false);
+          unaCorda_ = false;
           break;
         case midi::allNotesOff:
           for (int note = 0; note < 128; ++note) noteOff(note);

@@ -39,10 +39,15 @@ struct SynthSetup {
 
 // MIDI, omni (every channel plays the current instrument):
 //   note on/off (velocity 0 is a note-off); a note-on for a sounding key re-strikes that key's
-//   voice (its strings keep vibrating, as on a piano); CC64 sustain: 64…127 down, 0…63 up — no
-//   half-pedalling: a half value is simply up or down by that threshold; CC7 volume, gain
+//   voice (its strings keep vibrating, as on a piano); CC64 sustain, continuous (half-pedalling,
+//   damperContact()): the dampers of the keys released while it is down touch their strings with
+//   the pedal's contact, from fully on (0…20, as with no pedal) to fully lifted (100…127), and
+//   follow it until it is fully up; CC66 sostenuto, 64…127 down: the keys held as it goes down
+//   keep their dampers off the strings after their release until it lifts, keys struck later do
+//   not; CC67 una corda, 64…127 down: keys struck meanwhile strike two strings of three
+//   (UnisonStrings::noteOn); CC7 volume, gain
 //   (value/127)², smoothed over 10 ms; CC120 all sound off: every voice fades out in 5 ms;
-//   CC121 reset controllers: bend centred, pedal up; CC123 all notes off: as a note-off for every
+//   CC121 reset controllers: bend centred, pedals up; CC123 all notes off: as a note-off for every
 //   held key (the pedal still sustains them); pitch bend ±bend_range_semitones of the instrument
 //   (strings retension, plates do not bend); program change n selects instrument n (ignored
 //   beyond the last), sounding notes ring on in the old one.
@@ -66,6 +71,13 @@ class Synth {
   // How long the dampers take, as a multiple of each key's damper_t60_s (1: the preset's), clamped
   // to 0.1 … 10: a performance control, like the pedal, for the keys released from now on.
   void setDamperScale(double scale) noexcept;
+  // How much of its loss a released key's damper puts on the strings at CC64 `value`: 1 (fully on)
+  // up to 20, 0 (fully lifted) from 100, linear in between. A real damper pedal has free play at
+  // the top (the lever has not yet reached the damper tray; a sensor also reads a few counts at
+  // rest) and lifts the dampers clear of the strings before it bottoms out; between the two the
+  // felt's pressure on the string, and with it the loss it adds, grows with the way it is pressed
+  // in. So 0 and 127 are today's up and down to the bit, and 64 is a half pedal (contact 0.45).
+  static double damperContact(int value) noexcept;
   int polyphony() const;
   int activeVoices() const;
   // No key sounds, fades out or waits to be struck: what comes out now is the master bus's
@@ -91,7 +103,8 @@ class Synth {
   void render(std::span<float> left, std::span<float> right) noexcept;
   void noteOn(int note, int velocity) noexcept;
   void noteOff(int note) noexcept;
-  void setSustain(bool down) noexcept;
+  void setSustain(int value) noexcept;    // CC64
+  void setSostenuto(bool down) noexcept;  // CC66
   void setBend(double fraction) noexcept;
   void allSoundOff() noexcept;
   KeyVoice* keyVoice(int program, int note);
@@ -113,8 +126,9 @@ class Synth {
   int maxBlock_ = 0;
   int program_ = 0, polyphonyOverride_ = 0;
   int downProgram_[128];  // which instrument's voice a held note struck (−1: none)
-  bool sustain_ = false;
-  double bend_ = 0.0;  // −1 … 1 of the range
+  bool sostenuto_ = false, unaCorda_ = false;
+  double contact_ = 1.0;  // of the dampers of the keys released under the pedal (damperContact)
+  double bend_ = 0.0;     // −1 … 1 of the range
   double damperScale_ = 1.0;
   long strikes_ = 0;
   long steals_ = 0;

@@ -15,12 +15,13 @@ void UnisonStrings::reset() noexcept {
   for (StringVoice& s : strings_) s.reset();
 }
 
-void UnisonStrings::noteOn(double velocity) noexcept {
-  for (StringVoice& s : strings_) s.noteOn(velocity);
+void UnisonStrings::noteOn(double velocity, bool unaCorda) noexcept {
+  const size_t missed = unaCorda && strings_.size() == 3 ? 1 : 0;
+  for (size_t s = missed; s < strings_.size(); ++s) strings_[s].noteOn(velocity);
 }
 
-void UnisonStrings::release(double damperScale) noexcept {
-  for (StringVoice& s : strings_) s.release(damperScale);
+void UnisonStrings::release(double damperScale, double contact) noexcept {
+  for (StringVoice& s : strings_) s.release(damperScale, contact);
 }
 
 void UnisonStrings::setBend(double semitones) noexcept {

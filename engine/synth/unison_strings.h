@@ -17,8 +17,10 @@ class UnisonStrings {
   void prepare(const Instrument& instrument, int note, double sampleRate);
   void reset() noexcept;
 
-  void noteOn(double velocity) noexcept;
-  void release(double damperScale) noexcept;
+  // unaCorda (the soft pedal, CC67): the action shifted, the hammer misses the first string of a
+  // three-string unison and strikes the other two; keys of one or two strings are struck as ever.
+  void noteOn(double velocity, bool unaCorda = false) noexcept;
+  void release(double damperScale, double contact) noexcept;
   void setBend(double semitones) noexcept;
   void setQuietFloor(double floor) noexcept;  // each string's: the caller shares it among them
 

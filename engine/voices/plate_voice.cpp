@@ -176,8 +176,8 @@ double PlateVoice::pulseOverStep() const noexcept {
   return pulseForce_ * 0.5 * ((b - a) - (std::sin(w * b) - std::sin(w * a)) / w) / k_;
 }
 
-void PlateVoice::release(double damperScale) noexcept {
-  scheme_->setSigma0(releasedSigma0(loss_.sigma0, patch_.damperT60, damperScale, k_));
+void PlateVoice::release(double damperScale, double contact) noexcept {
+  scheme_->setSigma0(releasedSigma0(loss_.sigma0, patch_.damperT60, damperScale, k_, contact));
 }
 
 // Velocity (q^{n+1} − q^n)/k or displacement q^n, bilinear between the grid points around (x, y).

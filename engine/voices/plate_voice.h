@@ -51,8 +51,10 @@ class PlateVoice {
   void reset() noexcept;
 
   void noteOn(double velocity) noexcept;  // 0 … 1: a harder strike is louder and shorter
-  // The damper falls, its T60 damper_t60_s times `damperScale` (releasedSigma0).
-  void release(double damperScale = 1.0) noexcept;
+  // The damper falls, its T60 damper_t60_s times `damperScale` (releasedSigma0), touching the
+  // string with `contact` 0 … 1 of its loss (the half-pedal; 0: lifted, the voice's own loss).
+  // May be called again at any time to move the damper: the loss changes between two steps.
+  void release(double damperScale = 1.0, double contact = 1.0) noexcept;
   // Where the voice counts as silent and frees itself, as StringVoice::setQuietFloor.
   void setQuietFloor(double floor) noexcept { quiet_.setFloor(floor); }
 

@@ -246,8 +246,8 @@ void StringVoice::noteOn(double velocity) noexcept {
   active_ = true;
 }
 
-void StringVoice::release(double damperScale) noexcept {
-  scheme_->setSigma0(releasedSigma0(loss_.sigma0, patch_.damperT60, damperScale, k_));
+void StringVoice::release(double damperScale, double contact) noexcept {
+  scheme_->setSigma0(releasedSigma0(loss_.sigma0, patch_.damperT60, damperScale, k_, contact));
 }
 
 // The back-check: once the hammer has struck and left the string (escapement: no force drives

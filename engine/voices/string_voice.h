@@ -65,8 +65,10 @@ class StringVoice {
   void reset() noexcept;  // the string at rest, the hammer parked, the damper up
 
   void noteOn(double velocity) noexcept;  // velocity 0 … 1
-  // The damper falls, its T60 damper_t60_s times `damperScale` (releasedSigma0).
-  void release(double damperScale = 1.0) noexcept;
+  // The damper falls, its T60 damper_t60_s times `damperScale` (releasedSigma0), touching the
+  // string with `contact` 0 … 1 of its loss (the half-pedal; 0: lifted, the voice's own loss).
+  // May be called again at any time to move the damper: the loss changes between two steps.
+  void release(double damperScale = 1.0, double contact = 1.0) noexcept;
   // Bends the pitch by `semitones` (clamped to ±bendRange) by retensioning the transverse wave:
   // β T0 is solved in closed form so the scheme's fundamental moves by exactly that interval.
   void setBend(double semitones) noexcept;

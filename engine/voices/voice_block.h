@@ -17,10 +17,17 @@ inline void silence(std::span<float> left, std::span<float> right, size_t rightC
 // The loss σ0 of a released voice: its own σ0 plus ln(1000) / T60 of its damper, the damper's
 // T60 times `scale` (Synth::setDamperScale). The scheme needs σ0 k < 1; prepare() checked the
 // preset's damper against it, so a shorter scaled one is held at the larger of that and 0.9 / k.
-inline double releasedSigma0(double sigma0, double damperT60, double scale, double k) noexcept {
+// A damper touching the string partly (the half-pedal, Synth::damperContact) adds `contact`
+// (0 … 1) of its loss rate: the decay rate, 1/T60, moves linearly from the voice's own (0) to the
+// fully damped one (1), which is the value above to the bit. The loss stays ≥ σ0 ≥ 0 and under the
+// full damper's, so the scheme stays stable and only removes energy whatever the contact.
+inline double releasedSigma0(double sigma0, double damperT60, double scale, double k,
+                             double contact = 1.0) noexcept {
   constexpr double kLn1000 = 6.907755278982137;  // T60 = ln(1000) / σ
   const double preset = sigma0 + kLn1000 / damperT60;
-  return std::min(sigma0 + kLn1000 / (damperT60 * scale), std::max(preset, 0.9 / k));
+  const double full = std::min(sigma0 + kLn1000 / (damperT60 * scale), std::max(preset, 0.9 / k));
+  if (!(contact < 1.0)) return full;  // NaN too
+  return contact > 0.0 ? sigma0 + contact * (full - sigma0) : sigma0;
 }
 
 // A voice is free once its output has stayed 80 dB under its loudest since its last strike, and

@@ -198,18 +198,13 @@ TEST(NoAllocation, PlateVoiceProcess) {
   EXPECT_EQ(voice.guardEvents(), 0);
 }
 
-// The synthesizer's process(): every kind of event, a steal and its pending re-strike, the plate,
-// a program change, blocks of several sizes (1 to the prepared maximum, and beyond it).
-TEST(NoAllocation, SynthProcess) {
+// The synthesizer (prepared with blocks of 256) plays the events, then blocks of several sizes (1
+// to the prepared maximum, and beyond it), allocating nothing.
+void expectSynthProcessDoesNotAllocate(std::vector<Instrument> instruments,
+                                       std::span<const SynthEvent> events) {
   Synth synth;
-  synth.prepare({testing::pianoKeys(48, 52, 2), testing::smallPlate()},
-                {.sampleRate = 48000.0, .maxBlock = 256, .notes = {}});
+  synth.prepare(std::move(instruments), {.sampleRate = 48000.0, .maxBlock = 256, .notes = {}});
   std::vector<float> left(600), right(600);
-  const SynthEvent events[] = {
-      {0, {0x90, 48, 100}}, {3, {0x90, 50, 60}},  {5, {0xB0, 64, 127}},  {9, {0x90, 52, 127}},
-      {11, {0x80, 48, 0}},  {20, {0xE0, 0, 100}}, {30, {0x90, 48, 90}},  {40, {0xB0, 7, 90}},
-      {41, {0xB0, 64, 0}},  {50, {0xC0, 1, 0}},   {51, {0x90, 60, 127}}, {60, {0xB0, 123, 0}},
-      {70, {0xB0, 120, 0}}, {71, {0x90, 61, 80}}, {80, {0xF0, 0, 0}},    {90, {0xB0, 121, 0}}};
   const long before = forbiddenNews;
   forbidAllocation(true);
   synth.process(left, right, events);
@@ -219,6 +214,30 @@ TEST(NoAllocation, SynthProcess) {
   forbidAllocation(false);
   EXPECT_EQ(forbiddenNews - before, 0);
   EXPECT_EQ(synth.guardEvents(), 0);
+}
+
+// The synthesizer's process(): every kind of event, a steal and its pending re-strike, the plate,
+// a program change, blocks of several sizes (1 to the prepared maximum, and beyond it).
+TEST(NoAllocation, SynthProcess) {
+  const SynthEvent events[] = {
+      {0, {0x90, 48, 100}}, {3, {0x90, 50, 60}},  {5, {0xB0, 64, 127}},  {9, {0x90, 52, 127}},
+      {11, {0x80, 48, 0}},  {20, {0xE0, 0, 100}}, {30, {0x90, 48, 90}},  {40, {0xB0, 7, 90}},
+      {41, {0xB0, 64, 0}},  {50, {0xC0, 1, 0}},   {51, {0x90, 60, 127}}, {60, {0xB0, 123, 0}},
+      {70, {0xB0, 120, 0}}, {71, {0x90, 61, 80}}, {80, {0xF0, 0, 0}},    {90, {0xB0, 121, 0}}};
+  expectSynthProcessDoesNotAllocate({testing::pianoKeys(48, 52, 2), testing::smallPlate()}, events);
+}
+
+// The pedals: half-pedalling (CC64 between 20 and 100, moved while keys ring), sostenuto (CC66)
+// catching and letting go, una corda (CC67) on three-string keys, and reset controllers.
+TEST(NoAllocation, SynthPedals) {
+  Instrument piano = testing::pianoKeys(48, 52, 4);
+  for (StringKey& key : piano.keys) key.unisons = 3;
+  const SynthEvent events[] = {
+      {0, {0xB0, 67, 127}}, {1, {0x90, 48, 100}},  {3, {0x90, 50, 60}},  {5, {0xB0, 66, 127}},
+      {9, {0xB0, 64, 90}},  {11, {0x80, 48, 0}},   {20, {0x80, 50, 0}},  {30, {0xB0, 64, 64}},
+      {40, {0x90, 52, 90}}, {41, {0xB0, 67, 0}},   {50, {0x80, 52, 0}},  {60, {0xB0, 64, 30}},
+      {70, {0xB0, 66, 0}},  {71, {0xB0, 64, 127}}, {80, {0x90, 49, 80}}, {90, {0xB0, 121, 0}}};
+  expectSynthProcessDoesNotAllocate({piano}, events);
 }
 
 // The audio callback's work (app/player.cpp): the MIDI queue drained onto sample offsets and

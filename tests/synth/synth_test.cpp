@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <vector>
 
@@ -55,6 +56,152 @@ TEST(Synth, DamperScaleLengthensTheDecayOfReleasedKeys) {
   synth.setDamperScale(1.0);
   render(synth, {{0.0, on(50)}, {0.1, off(50)}}, 1.1, 256);
   EXPECT_FALSE(synth.voice(0, 50)->sounding());
+}
+
+// The decay rate of a key, dB/s, from the RMS of two 50 ms windows of the take (seconds).
+double decayDbPerS(const Take& take, double from, double to) {
+  auto rms = [&](double t) {
+    const size_t a = std::lround(t * kRate), b = std::lround((t + 0.05) * kRate);
+    double sum = 0.0;
+    for (size_t i = a; i < b; ++i) sum += double(take.left[i]) * take.left[i];
+    return std::sqrt(sum / double(b - a));
+  };
+  return 20.0 * std::log10(rms(from) / rms(to)) / (to - from);
+}
+
+// A key released at 0.2 s under the pedal at `value` (none: no CC64 at all); `held`: never
+// released. The damper T60 is 1 s (60 dB/s) so that even fully damped the key stays well above
+// roundoff over the measurement; the voices never free themselves, as references. Struck softly
+// (40): at 100 the string's tension modulation moves energy between its partials enough to bend
+// the held key's measured decay (1.2 dB/s instead of its partials' 7 or so).
+Take releasedUnderPedal(int value, bool held = false) {
+  Instrument piano = pianoKeys(48, 48);
+  piano.keys[0].patch.damperT60 = 1.0;
+  Synth synth = prepared({piano}, 256, false);
+  std::vector<TimedMessage> score;
+  if (value >= 0) score.push_back({0.0, cc(64, value)});
+  score.push_back({0.0, on(48, 40)});
+  if (!held) score.push_back({0.2, off(48)});
+  return render(synth, score, 1.0, 256);
+}
+
+// Half-pedalling: the decay rate of a released key falls monotonically with CC64 from the damped
+// one (0, and the pedal's free play up to 20: bit for bit a key released without any pedal) to
+// the undamped one (127, and from 100: bit for bit a key still held). In between the damper adds
+// damperContact() of its 60 dB/s; the key's own decay is the same throughout, so the measured
+// rate is the held key's plus that share, within 1.5 dB/s (the 50 ms windows over a 130 Hz
+// string's partials, decaying at several rates, are not a pure exponential).
+TEST(Synth, HalfPedalSetsTheDecayBetweenDampedAndUndamped) {
+  const Take released = releasedUnderPedal(-1), held = releasedUnderPedal(-1, true);
+  EXPECT_EQ(releasedUnderPedal(0).left, released.left);
+  EXPECT_EQ(releasedUnderPedal(20).left, released.left);
+  EXPECT_EQ(releasedUnderPedal(127).left, held.left);
+  EXPECT_EQ(releasedUnderPedal(100).left, held.left);
+  const double damped = decayDbPerS(released, 0.5, 0.8), free = decayDbPerS(held, 0.5, 0.8);
+  EXPECT_NEAR(damped - free, 60.0, 3.0);
+  double previous = INFINITY;
+  for (int value : {0, 32, 64, 96, 127}) {
+    const double rate = decayDbPerS(releasedUnderPedal(value), 0.5, 0.8);
+    std::printf("CC64 %3d: contact %.3f, decay %.1f dB/s\n", value, Synth::damperContact(value),
+                rate);
+    EXPECT_LT(rate, previous) << "CC64 " << value;
+    EXPECT_NEAR(rate, free + Synth::damperContact(value) * (damped - free), 1.5) << value;
+    previous = rate;
+  }
+  const double half = decayDbPerS(releasedUnderPedal(64), 0.5, 0.8);
+  EXPECT_GT(half, free + 10.0);
+  EXPECT_LT(half, damped - 10.0);
+}
+
+// The pedal moved while a released key rings changes its decay from that moment: lifted fully
+// (127) it holds, half down (64) it decays at the half pedal's rate, down (0) at the damper's. The
+// loss changes between two steps, so the signal has no step: no sample-to-sample jump after the
+// changes larger than the key's own largest before them.
+TEST(Synth, MovingThePedalWhileAKeyRingsChangesItsDecayWithoutAClick) {
+  Instrument piano = pianoKeys(48, 48);
+  piano.keys[0].patch.damperT60 = 1.0;
+  Synth synth = prepared({piano}, 256, false);
+  const Take take = render(
+      synth,
+      {{0.0, cc(64, 127)}, {0.0, on(48)}, {0.1, off(48)}, {0.6, cc(64, 64)}, {1.0, cc(64, 0)}}, 1.4,
+      256);
+  const double sustained = decayDbPerS(take, 0.3, 0.5), half = decayDbPerS(take, 0.7, 0.9),
+               damped = decayDbPerS(take, 1.1, 1.3);
+  EXPECT_LT(sustained, half - 10.0);
+  EXPECT_LT(half, damped - 10.0);
+  float before = 0.0f, after = 0.0f;
+  for (size_t i = 12000; i < take.left.size(); ++i) {  // from 0.25 s; the change at 0.6 s
+    float& largest = i < 28800 ? before : after;
+    largest = std::max(largest, std::abs(take.left[i] - take.left[i - 1]));
+  }
+  EXPECT_LE(after, before);
+}
+
+// Sostenuto (CC66): 48, held as the pedal goes down, rings on after its release (its own T60 of
+// 8 s: after 0.5 s within a few dB of its peak); 52, struck after, is damped at its release (T60
+// 0.25 s: 120 dB down in 0.5 s). Lifting the pedal damps 48 too. Levels from the keys' rendered
+// output (KeyVoice::level).
+TEST(Synth, SostenutoHoldsOnlyTheKeysHeldAsItGoesDown) {
+  Synth synth = prepared({pianoKeys(48, 52)}, 256, false);
+  render(synth, {{0.0, on(48)}, {0.1, cc(66, 127)}, {0.2, on(52)}, {0.3, off(48)}, {0.3, off(52)}},
+         0.8, 256);
+  EXPECT_GT(synth.voice(0, 48)->level(), 0.3);
+  EXPECT_LT(synth.voice(0, 52)->level(), 1e-3);
+  EXPECT_TRUE(synth.voice(0, 48)->caught);
+  // A key struck and released under the sustain pedal meanwhile is the sustain pedal's alone.
+  render(synth, {{0.0, cc(64, 127)}, {0.0, on(50)}, {0.1, off(50)}, {0.2, cc(64, 0)}}, 0.8, 256);
+  EXPECT_GT(synth.voice(0, 48)->level(), 0.2);
+  EXPECT_LT(synth.voice(0, 50)->level(), 1e-3);
+  render(synth, {{0.0, cc(66, 0)}}, 0.5, 256);
+  EXPECT_FALSE(synth.voice(0, 48)->caught);
+  EXPECT_LT(synth.voice(0, 48)->level(), 1e-3);
+  // Reset controllers lifts it too.
+  render(synth, {{0.0, on(49)}, {0.05, cc(66, 127)}, {0.1, cc(121, 0)}, {0.15, off(49)}}, 0.7, 256);
+  EXPECT_LT(synth.voice(0, 49)->level(), 1e-3);
+}
+
+// Una corda (CC67): a three-string key struck with the soft pedal down strikes two of its strings
+// — the energy of two hammers' shares of three, so its level is about 20·log10(2/3) = −3.5 dB
+// (its amplitude, two strings of the same amplitude instead of three), within 1 dB (the strings'
+// cent of detuning beat differently); it stays on pitch. A key of one string is struck as ever, bit
+// for bit; the pedal up, three strings again.
+TEST(Synth, UnaCordaStrikesTwoStringsOfThree) {
+  Instrument piano = pianoKeys(57, 57);
+  piano.keys[0].unisons = 3;
+  piano.keys[0].detuneCents = 2.0;  // the strings at −1, 0 and +1 cent
+  piano.gainDb = -20.0;             // well under the master's limiter (0.98)
+  auto take = [&](bool soft) {
+    Synth synth = prepared({piano}, 256, false);
+    std::vector<TimedMessage> score;
+    if (soft) score.push_back({0.0, cc(67, 127)});
+    score.push_back({0.0, on(57, 40)});
+    return render(synth, score, 1.0, 256);
+  };
+  const Take full = take(false), soft = take(true);
+  auto rms = [](const Take& t) {
+    double sum = 0.0;
+    for (size_t i = 2400; i < 12000; ++i) sum += double(t.left[i]) * t.left[i];
+    return std::sqrt(sum / 9600.0);
+  };
+  const double db = 20.0 * std::log10(rms(soft) / rms(full));
+  std::printf("una corda: %.2f dB\n", db);
+  EXPECT_NEAR(db, 20.0 * std::log10(2.0 / 3.0), 1.0);
+  // On pitch: the three strings' mean is the note (the test string itself sounds about half a
+  // cent sharp of 220 Hz: its stiffness); the two struck are its middle and highest, 0 and +1
+  // cent, so the soft note is sharp of the full one by their mean, 0.5 cent (± 0.2: the
+  // zero-crossing count over 0.5 s).
+  auto cents = [](const Take& t) {
+    std::vector<double> x(t.left.begin() + 24000, t.left.end());
+    return testing::cents(testing::zeroCrossingFrequency(x, 1.0 / kRate), 220.0);
+  };
+  std::printf("three strings %+.2f cents, una corda %+.2f cents\n", cents(full), cents(soft));
+  EXPECT_NEAR(cents(full), 0.0, 1.0);
+  EXPECT_NEAR(cents(soft) - cents(full), 0.5, 0.2);
+  // One string: the pedal changes nothing.
+  Instrument one = pianoKeys(57, 57);
+  Synth a = prepared({one}, 256, false), b = prepared({one}, 256, false);
+  EXPECT_EQ(render(a, {{0.0, on(57)}}, 0.2, 256).left,
+            render(b, {{0.0, cc(67, 127)}, {0.0, on(57)}}, 0.2, 256).left);
 }
 
 TEST(Synth, RestrikingASoundingKeyReexcitesTheSameVoice) {
