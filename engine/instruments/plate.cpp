@@ -77,7 +77,6 @@ VonKarmanPlate::VonKarmanPlate(const PlatePhysics& p, int segmentsX, int segment
       inverseSquared_(i, j) = 1.0 / std::pow(laplacianEigenvalue(i + 1, j + 1), 2);
   airy_.setZero(n);
   work_.setZero(n);
-  lap_.setZero(n);
   spectral_.setZero(rows_, ny_);
   half_.setZero(rows_, ny_);
   const Eigen::Index bordered = px_ * (ny_ + 2);
@@ -157,13 +156,18 @@ void VonKarmanPlate::transformY() const {
   for (int j = 0; j < high; ++j) spectral_.col(ny_ - 1 - j) = evenY_.col(j) - oddY_.col(j);
 }
 
-void VonKarmanPlate::solveBiharmonic(const Vector& rhs, Vector& f) const {
+void VonKarmanPlate::solveBiharmonic(const Vector& rhs, Vector& f) const { airySolve(rhs, f); }
+
+double VonKarmanPlate::airySolve(const Vector& rhs, Vector& f) const {
   transformX(rhs.data(), nx_);  // R̂ = S_x R S_y
   transformY();
+  // ‖DΔF‖² = Σ λ² F̂² = Σ R̂²/λ² (the transforms are orthonormal; F̂ = R̂/λ²)
+  const double norm = (spectral_.array().square() * inverseSquared_.array()).sum();
   spectral_.array() *= inverseSquared_.array();  // F̂ = R̂ / λ²
   transformX(spectral_.data(), rows_);           // F = S_x F̂ S_y
   transformY();
   Eigen::Map<Eigen::MatrixXd>(f.data(), nx_, ny_) = spectral_.topRows(nx_);
+  return norm;
 }
 
 // ℓ(f, g) of (78), on bordered copies: each mixed difference at a point is a cell difference of one
@@ -194,9 +198,9 @@ double VonKarmanPlate::airyAndPotential(const Vector& q) const {
   bracketOfState(paddedQ_, cellsQ_);
   // DΔΔ F = −(Eξ/2) ℓ(q, q)   (79)
   unpad(paddedOut_, -0.5 * physics_.young * physics_.thickness, work_);
-  solveBiharmonic(work_, airy_);
-  laplacian(airy_, lap_);  // leaves F's bordered copy in paddedF_
-  return hx_ * hy_ / (2.0 * physics_.young * physics_.thickness) * lap_.squaredNorm();  // (81)
+  const double norm = airySolve(work_, airy_);
+  pad(airy_.data(), paddedF_);  // F's bordered copy, for the gradient's bracket
+  return hx_ * hy_ / (2.0 * physics_.young * physics_.thickness) * norm;  // (81)
 }
 
 double VonKarmanPlate::splitPotential(const Vector& q) const { return airyAndPotential(q); }

@@ -63,7 +63,8 @@ class VonKarmanPlate {
   void setKernels(const Kernels& kernels) noexcept { kernels_ = &kernels; }
 
  private:
-  double airyAndPotential(const Vector& q) const;   // fills airy_, returns V'
+  double airyAndPotential(const Vector& q) const;        // fills airy_, returns V'
+  double airySolve(const Vector& rhs, Vector& f) const;  // solveBiharmonic; returns ‖DΔF‖²
   void pad(const double* v, Vector& padded) const;  // v's nx × ny values inside the zero border
   // out = scale × the interior of a bordered grid
   void unpad(const Vector& padded, double scale, Vector& out) const;
@@ -87,7 +88,7 @@ class VonKarmanPlate {
   // syOdd_(o, j) = S_y(2o + 1, j), j < ⌈ny/2⌉.
   Eigen::MatrixXd sxEven_, sxOdd_, syEven_, syOdd_;
   Eigen::MatrixXd inverseSquared_;  // 1 / λ_ij² of DΔΔ, rows_ × ny (0 beyond nx)
-  mutable Vector airy_, work_, lap_;
+  mutable Vector airy_, work_;
   mutable Eigen::MatrixXd spectral_, half_;  // rows_ × ny scratch of the transforms
   mutable Eigen::MatrixXd evenX_, oddX_;     // halfRows_ × ny: the half products along x
   mutable Eigen::MatrixXd evenY_, oddY_;     // rows_ × ⌈ny/2⌉: along y
