@@ -8,14 +8,13 @@
 #include <string>
 #include <vector>
 
+#include "held_keys.h"
 #include "presets/preset_loader.h"
 #include "synth/synth.h"
 
 namespace hamiltone {
 namespace {
 
-constexpr double kSampleRate = 48000.0;
-constexpr int kBlockSize = 256;
 constexpr double kRestrikeS = 0.5;
 
 struct Bundled {
@@ -27,35 +26,11 @@ const Bundled kPresets[] = {{"grand-piano", 6}, {"paper-c3-string", 3}, {"steel-
 
 void presetCost(benchmark::State& state) {
   const Bundled& preset = kPresets[state.range(0)];
-  Instrument instrument =
+  const Instrument instrument =
       loadPreset(std::string(HAMILTONE_SOURCE_DIR "/presets/") + preset.name + ".toml");
-  std::vector<bool> notes(128, false);
-  std::vector<SynthEvent> strike;
-  for (int key = instrument.lowestNote; key <= instrument.highestNote; key += preset.everyNth) {
-    notes[key] = true;
-    strike.push_back({0, {0x90, static_cast<std::uint8_t>(key), 90}});
-  }
-  const int keys = static_cast<int>(strike.size());
-  Synth synth;
-  synth.prepare({instrument},
-                {.sampleRate = kSampleRate, .maxBlock = kBlockSize, .notes = notes, .threads = 1});
-  synth.setPolyphony(keys);
-  std::vector<float> left(kBlockSize), right(kBlockSize);
-  const int restrike = static_cast<int>(kRestrikeS * kSampleRate / kBlockSize);
-  int blocks = 0;
-  for (auto _ : state) {
-    const bool now = blocks++ % restrike == 0;
-    synth.process(left, right,
-                  now ? std::span<const SynthEvent>(strike) : std::span<const SynthEvent>());
-    benchmark::DoNotOptimize(left.data());
-  }
-  if (synth.activeVoices() != keys) state.SkipWithError("not every key kept sounding");
+  playHeldKeys(state, instrument, everyNthKey(instrument, preset.everyNth), 256, kRestrikeS);
   state.SetLabel(preset.name);
-  state.counters["keys"] = keys;
   state.counters["polyphony"] = instrument.polyphony;
-  state.counters["t/key/sample"] =
-      benchmark::Counter(static_cast<double>(state.iterations()) * kBlockSize * keys,
-                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
 // The console table, then one line per preset: its keys per core in real time.
@@ -64,14 +39,9 @@ class CostReporter : public benchmark::ConsoleReporter {
   CostReporter() : ConsoleReporter(OO_Tabular) {}
   void ReportRuns(const std::vector<Run>& runs) override {
     ConsoleReporter::ReportRuns(runs);
-    for (const Run& run : runs) {
-      const auto perKey = run.counters.find("t/key/sample");
-      const bool median = run.run_type == Run::RT_Aggregate && run.aggregate_name == "median";
-      if (run.error_occurred || perKey == run.counters.end() ||
-          !(median || (run.run_type == Run::RT_Iteration && run.repetitions <= 1)))
-        continue;
-      lines[run.report_label] = {perKey->second.value, run.counters.at("polyphony").value};
-    }
+    for (const Run& run : runs)
+      if (const auto cost = keyCostOf(run))
+        lines[run.report_label] = {*cost, run.counters.at("polyphony").value};
   }
   struct Line {
     double secondsPerKeySample, polyphony;
@@ -95,7 +65,7 @@ int main(int argc, char** argv) {
   std::printf("\n%-16s %16s %14s %10s\n", "preset", "% of a core/key", "keys per core",
               "polyphony");
   for (const auto& [name, line] : reporter.lines) {
-    const double coreFraction = line.secondsPerKeySample * hamiltone::kSampleRate;
+    const double coreFraction = line.secondsPerKeySample * hamiltone::kHeldKeysSampleRate;
     std::printf("%-16s %16.1f %14.1f %10.0f\n", name.c_str(), 100.0 * coreFraction,
                 1.0 / coreFraction, line.polyphony);
   }

@@ -12,44 +12,28 @@
 #include <string>
 #include <vector>
 
+#include "held_keys.h"
 #include "presets/preset_loader.h"
 #include "synth/synth.h"
 
 namespace hamiltone {
 namespace {
 
-constexpr double kSampleRate = 48000.0;
 constexpr int kLowestKey = 48;      // C3: keys C3, C#3, … upward, the middle register
 constexpr double kRestrikeS = 2.0;  // keys are struck again every 2 s, well inside their T60s
 
 void chord(benchmark::State& state) {
   const int voices = static_cast<int>(state.range(0));
   const int block = static_cast<int>(state.range(1));
-  Instrument piano = loadPreset(HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml");
-  std::vector<bool> notes(128, false);
-  for (int i = 0; i < voices; ++i) notes[kLowestKey + i] = true;
-  Synth synth;
-  synth.prepare({piano},
-                {.sampleRate = kSampleRate, .maxBlock = block, .notes = notes, .threads = 1});
-  synth.setPolyphony(voices);
-  std::vector<SynthEvent> strike;
-  for (int i = 0; i < voices; ++i)
-    strike.push_back({0, {0x90, static_cast<std::uint8_t>(kLowestKey + i), 90}});
-  std::vector<float> left(block), right(block);
-  const int restrike = static_cast<int>(kRestrikeS * kSampleRate / block);
-  int blocks = 0;
-  for (auto _ : state) {
-    const bool now = blocks++ % restrike == 0;
-    synth.process(left, right,
-                  now ? std::span<const SynthEvent>(strike) : std::span<const SynthEvent>());
-    benchmark::DoNotOptimize(left.data());
-  }
-  if (synth.activeVoices() != voices) state.SkipWithError("not every key kept sounding");
-  state.counters["x_realtime"] = benchmark::Counter(
-      static_cast<double>(state.iterations()) * block / kSampleRate, benchmark::Counter::kIsRate);
+  const Instrument piano = loadPreset(HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml");
+  std::vector<int> keys;
+  for (int i = 0; i < voices; ++i) keys.push_back(kLowestKey + i);
+  playHeldKeys(state, piano, keys, block, kRestrikeS);
+  state.counters["x_realtime"] =
+      benchmark::Counter(static_cast<double>(state.iterations()) * block / kHeldKeysSampleRate,
+                         benchmark::Counter::kIsRate);
   state.counters["strings"] = 0;
-  for (int i = 0; i < voices; ++i)
-    state.counters["strings"] += piano.keys[kLowestKey + i - piano.lowestNote].unisons;
+  for (int key : keys) state.counters["strings"] += piano.keys[key - piano.lowestNote].unisons;
 }
 
 // Every 6th key from A0 to C8 (15 keys, all unison strings) struck together and held: the time per
@@ -58,35 +42,10 @@ constexpr const char* kGridRules[] = {"two-grid", "transverse"};
 
 void keyboard(benchmark::State& state) {
   const char* rule = kGridRules[state.range(0)];
-  constexpr int kBlockSize = 256;
-  Instrument piano = loadPreset(HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml",
-                                {.overrides = {{"scheme.grid_rule", rule}}});
-  std::vector<bool> notes(128, false);
-  std::vector<SynthEvent> strike;
-  for (int key = piano.lowestNote; key <= piano.highestNote; key += 6) {
-    notes[key] = true;
-    strike.push_back({0, {0x90, static_cast<std::uint8_t>(key), 90}});
-  }
-  const int keys = static_cast<int>(strike.size());
-  Synth synth;
-  synth.prepare({piano},
-                {.sampleRate = kSampleRate, .maxBlock = kBlockSize, .notes = notes, .threads = 1});
-  synth.setPolyphony(keys);
-  std::vector<float> left(kBlockSize), right(kBlockSize);
-  const int restrike = static_cast<int>(kRestrikeS * kSampleRate / kBlockSize);
-  int blocks = 0;
-  for (auto _ : state) {
-    const bool now = blocks++ % restrike == 0;
-    synth.process(left, right,
-                  now ? std::span<const SynthEvent>(strike) : std::span<const SynthEvent>());
-    benchmark::DoNotOptimize(left.data());
-  }
-  if (synth.activeVoices() != keys) state.SkipWithError("not every key kept sounding");
+  const Instrument piano = loadPreset(HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml",
+                                      {.overrides = {{"scheme.grid_rule", rule}}});
+  playHeldKeys(state, piano, everyNthKey(piano, 6), 256, kRestrikeS);
   state.SetLabel(rule);
-  state.counters["keys"] = keys;
-  state.counters["t/key/sample"] =
-      benchmark::Counter(static_cast<double>(state.iterations()) * kBlockSize * keys,
-                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
 }  // namespace
@@ -109,12 +68,8 @@ class ChordReporter : public benchmark::ConsoleReporter {
   void ReportRuns(const std::vector<Run>& runs) override {
     ConsoleReporter::ReportRuns(runs);
     for (const Run& run : runs) {
-      // A single run's figure, or with repetitions their median.
-      const auto perKey = run.counters.find("t/key/sample");
-      const bool median = run.run_type == Run::RT_Aggregate && run.aggregate_name == "median";
-      if (!run.error_occurred && perKey != run.counters.end() && !run.report_label.empty() &&
-          (median || (run.run_type == Run::RT_Iteration && run.repetitions <= 1)))
-        keyCost[run.report_label] = perKey->second.value;
+      if (const auto cost = hamiltone::keyCostOf(run); cost && !run.report_label.empty())
+        keyCost[run.report_label] = *cost;
       const auto speed = run.counters.find("x_realtime");
       if (run.error_occurred || speed == run.counters.end() || speed->second.value < 1.0) continue;
       const std::string& args = run.run_name.args;  // "voices:16/block:256"
