@@ -110,11 +110,13 @@ void VonKarmanPlate::unpad(const Vector& padded, double scale, Vector& out) cons
   }
 }
 
-void VonKarmanPlate::laplacian(const Vector& f, Vector& out) const {
+void VonKarmanPlate::laplacian(const Vector& f, Vector& out) const { scaledLaplacian(f, 1.0, out); }
+
+void VonKarmanPlate::scaledLaplacian(const Vector& f, double scale, Vector& out) const {
   pad(f.data(), paddedF_);
   kernels_->gridLaplacian(paddedF_.data(), px_, ny_, 1.0 / (hx_ * hx_), 1.0 / (hy_ * hy_),
                           paddedOut_.data());
-  unpad(paddedOut_, 1.0, out);
+  unpad(paddedOut_, scale, out);
 }
 
 void VonKarmanPlate::applyStiffness(const Vector& q, Vector& out) const {
@@ -127,8 +129,7 @@ void VonKarmanPlate::applyStiffness(const Vector& q, Vector& out) const {
 
 void VonKarmanPlate::applyLossOperator(const Vector& a, const Vector& b, Vector& out) const {
   work_ = a - b;
-  laplacian(work_, out);
-  out *= -physics_.density * physics_.thickness * hx_ * hy_;
+  scaledLaplacian(work_, -physics_.density * physics_.thickness * hx_ * hy_, out);
 }
 
 void VonKarmanPlate::transformX(const double* r, long ld) const {

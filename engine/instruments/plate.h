@@ -68,6 +68,7 @@ class VonKarmanPlate {
   void pad(const double* v, Vector& padded) const;  // v's nx × ny values inside the zero border
   // out = scale × the interior of a bordered grid
   void unpad(const Vector& padded, double scale, Vector& out) const;
+  void scaledLaplacian(const Vector& f, double scale, Vector& out) const;  // scale × DΔ f
   void transformX(const double* r, long ld) const;  // S_x R (R nx × ny) into half_
   void transformY() const;                          // half_ S_y into spectral_
   void padState(const Vector& q) const;             // q's bordered copy and cells
