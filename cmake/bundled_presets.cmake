@@ -2,7 +2,7 @@
 # bundledPresets() (plugin/bundled_presets.h), from the presets named in HAMILTONE_PLUGIN_PRESETS,
 # in that order (the first is the plugin's default). Rewritten when a preset changes.
 set(HAMILTONE_PLUGIN_PRESETS grand-piano paper-c3-string steel-plate gong thunder-sheet
-                             small-cymbal)
+                             small-cymbal grand-piano-strings)
 
 function(hamiltone_bundled_presets output)
   set(files "")

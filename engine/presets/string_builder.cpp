@@ -36,6 +36,9 @@ constexpr VoiceField kStringFields[] = {
     {"young", "string.young_Pa"},
     {"grid factor", "scheme.grid_factor"},
     {"hammer mass", "hammer.mass_kg"},
+    {"bridge_mass_kg", "bridge.mass_kg"},
+    {"bridge_stiffness_N_m", "bridge.stiffness_N_m"},
+    {"bridge_resistance_kg_s", "bridge.resistance_kg_s"},
     {"hammer stiffness", "hammer.stiffness_N_per_m_p"},
     {"hammer exponent", "hammer.exponent"},
     {"hammer position", "hammer.position"},
@@ -79,7 +82,7 @@ void buildStringKeys(const PresetValues& values, Instrument& instrument) {
 
   for (int note = instrument.lowestNote; note <= instrument.highestNote; ++note) {
     auto at = [&](std::string_view name) { return values.atKey(values.row(name), note); };
-    StringKey key{.patch = common};
+    StringKey key{.patch = common, .unisons = 1, .detuneCents = 0.0, .bridge = {}};
     StringPatch& p = key.patch;
     const double d = at("string.diameter_m");
     p.string.area = std::numbers::pi * d * d / 4.0;
@@ -97,6 +100,9 @@ void buildStringKeys(const PresetValues& values, Instrument& instrument) {
     p.damperT60 = at("loss.damper_t60_s");
     key.unisons = static_cast<int>(at("string.unisons"));
     key.detuneCents = at("string.detune_cents");
+    key.bridge = {.mass = at("bridge.mass_kg"),
+                  .stiffness = at("bridge.stiffness_N_m"),
+                  .resistance = at("bridge.resistance_kg_s")};
     instrument.keys.push_back(key);
   }
 }
@@ -110,10 +116,16 @@ void checkStringVoices(const Instrument& instrument, const PresetValues& values,
     if (a.note >= lo && a.note <= hi) notes.insert(a.note);  // a --set may narrow the range
   // The patches the synthesizer plays: the outermost unison strings carry the detune extremes.
   for (int note : notes) try {
-      const int unisons = instrument.keys[note - lo].unisons;
-      for (int string : {0, unisons - 1}) {
+      const StringKey& key = instrument.keys[note - lo];
+      double added = 0.0;  // the outermost strings' K_s, the middle one's taken as theirs
+      for (int string : {0, key.unisons - 1}) {
         StringVoice voice;
         voice.prepare(unisonPatch(instrument, note, string), note, kCheckRate);
+        added += voice.coupling().selfStiffness() * key.unisons / 2.0;
+      }
+      if (key.bridge.mass > 0.0) {
+        const double k = 1.0 / (kCheckRate * key.patch.oversampling);
+        Bridge().prepare(key.bridge, k, added * std::pow(2.0, 2.0 * instrument.bendRange / 12.0));
       }
     } catch (const std::exception& e) {
       refused(e.what(), note);

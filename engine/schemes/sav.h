@@ -101,6 +101,16 @@ class SavScheme {
   }
   double supplied() const { return supplied_; }
 
+  // A force on a few coordinates (a string's last nodes held by a bridge): as setForce() but
+  // without a pass over the grid — b gains k² M⁻¹ f at those coordinates only. Each step takes
+  // the values set last (slot 0 … kPointForces−1; an unset slot is 0) and adds their work to
+  // supplied().
+  static constexpr int kPointForces = 2;
+  void setPointForce(int slot, Eigen::Index i, double f) noexcept {
+    pointIndex_[slot] = i;
+    pointForce_[slot] = f;
+  }
+
   // Sets coordinate i at levels n and n+1 — a hammer placed and launched, or caught. The caller
   // keeps V' unchanged by it (the coordinate out of contact), so ψ stays consistent; the energy
   // changes by the kinetic energy given or taken, which energy() then reports.
@@ -222,6 +232,11 @@ class SavScheme {
         }
       }
     }
+    // The point forces enter b as k² M⁻¹ f at their coordinates: −gMCq gains k² ∇V'_jᵀ M⁻¹ f.
+    for (int p = 0; p < kPointForces; ++p) {
+      const Eigen::Index i = pointIndex_[p];
+      for (int a = 0; a < parts; ++a) gMCq[a] -= kk * g[a][i] * minv[i] * pointForce_[p];
+    }
     // (40) with the loss (49) and the σ1 term:
     //   b = (2I − k²M⁻¹K) q^n − 2k Σ ψ_j α_j − ((1−σ0k) I − Σ α_j β_jᵀ) q^{n−1}
     //       − 2σ1k M⁻¹C (q^n − q^{n−1}),
@@ -265,6 +280,14 @@ class SavScheme {
         const double x = newPosition(i, correction);
         for (int a = 0; a < parts; ++a) gdq[a] += g[a][i] * (x - qm[i]);
       }
+    }
+    // The point forces' share of q^{n+1}, added after pass 2 wrote the rest.
+    for (int p = 0; p < kPointForces; ++p) {
+      const Eigen::Index i = pointIndex_[p];
+      const double dx = kk * minv[i] * pointForce_[p] * invUp;
+      qp[i] += dx;
+      for (int a = 0; a < parts; ++a) gdq[a] += g[a][i] * dx;
+      supplied_ += 0.5 * pointForce_[p] * (qp[i] - qm[i]);
     }
     for (int a = 0; a < parts; ++a) psi_[a] += 0.5 * s[a] * gdq[a];  // (38c)
     if constexpr (lossy) {
@@ -322,7 +345,9 @@ class SavScheme {
   Vector force_;                     // external force f, N per coordinate
   Vector extra_;  // 2σ1k C(q^n − q^{n−1}) − k² f: what b loses through M⁻¹
   bool forced_ = false;
-  double supplied_ = 0.0;  // work of f since the start
+  std::array<Eigen::Index, kPointForces> pointIndex_{};
+  std::array<double, kPointForces> pointForce_{};
+  double supplied_ = 0.0;  // work of f and of the point forces since the start
   double dissipated_ = 0.0;
   long n_ = 0;
   const Kernels* kernels_ = &selectedKernels();

@@ -17,6 +17,7 @@ struct StringKey {
   StringPatch patch;         // tuned to the key's note by the voice
   int unisons = 1;           // 1, 2 or 3
   double detuneCents = 0.0;  // between the outermost strings: they sit at ±detune/2 (and 0)
+  BridgePhysics bridge;      // the strings' common end; mass 0: rigid ends, each string alone
 };
 
 struct Instrument {

@@ -15,7 +15,7 @@ void KeyVoice::prepare(const Instrument& instrument, int note, double sampleRate
                        bool freeQuiet) {
   std::variant<UnisonStrings, PlateVoice> voice;
   if (instrument.model == InstrumentModel::string)
-    voice.emplace<UnisonStrings>().prepare(instrument, note, sampleRate);
+    voice.emplace<UnisonStrings>().prepare(instrument, note, sampleRate, maxBlock);
   else
     voice.emplace<PlateVoice>().prepare(instrument.plate, note, sampleRate);
   // Constant-power pan across the keyboard, scaled so a centred key keeps unit gain per channel.
@@ -34,7 +34,7 @@ void KeyVoice::prepare(const Instrument& instrument, int note, double sampleRate
                        static_cast<double>(std::max<size_t>(strings ? strings->size() : 0, 1));
   const double floor = freeQuiet ? QuietDetector::kFloor / heard : -1.0;
   std::visit([floor](auto& v) { v.setQuietFloor(floor); }, voice_);
-  for (auto* buffer : {&voiceLeft_, &voiceRight_, &mixLeft_, &mixRight_, &outLeft_, &outRight_})
+  for (auto* buffer : {&mixLeft_, &mixRight_, &outLeft_, &outRight_})
     buffer->assign(maxBlock, 0.0f);
   frames_ = 0;
   fadeSamples_ = std::max(1, static_cast<int>(std::lround(kFadeS * sampleRate)));
@@ -136,24 +136,13 @@ void KeyVoice::process(size_t frames, double gain) noexcept {
 void KeyVoice::render(std::span<float> left, std::span<float> right, double gain) noexcept {
   const size_t n = left.size();
   std::span<float> mixL(mixLeft_.data(), n), mixR(mixRight_.data(), n);
-  std::span<float> voiceL(voiceLeft_.data(), n), voiceR(voiceRight_.data(), n);
-  std::fill(mixL.begin(), mixL.end(), 0.0f);
-  std::fill(mixR.begin(), mixR.end(), 0.0f);
-  auto add = [&](bool stereo) {
-    for (size_t i = 0; i < n; ++i) {
-      mixL[i] += voiceL[i];
-      mixR[i] += stereo ? voiceR[i] : voiceL[i];  // a mono voice feeds both channels
-    }
-  };
   if (UnisonStrings* strings = std::get_if<UnisonStrings>(&voice_)) {
-    for (StringVoice& s : strings->strings()) {
-      if (!s.active()) continue;
-      s.process(voiceL, voiceR);
-      add(s.channels() == 2);
-    }
-  } else if (PlateVoice* plate = std::get_if<PlateVoice>(&voice_); plate->active()) {
-    plate->process(voiceL, voiceR);
-    add(true);
+    strings->process(mixL, mixR);  // silence when no string sounds
+  } else if (PlateVoice& plate = std::get<PlateVoice>(voice_); plate.active()) {
+    plate.process(mixL, mixR);
+  } else {
+    std::fill(mixL.begin(), mixL.end(), 0.0f);
+    std::fill(mixR.begin(), mixR.end(), 0.0f);
   }
   const double gl = gain * panLeft_, gr = gain * panRight_;
   sinceStrike_ += static_cast<long>(n);

@@ -67,7 +67,7 @@ class KeyVoice {
   void strikeNow(double velocity, bool unaCorda) noexcept;
 
   std::variant<UnisonStrings, PlateVoice> voice_;  // one voice type per instrument model
-  std::vector<float> voiceLeft_, voiceRight_, mixLeft_, mixRight_, outLeft_, outRight_;
+  std::vector<float> mixLeft_, mixRight_, outLeft_, outRight_;
   size_t frames_ = 0;  // written to the outputs by the last process()
   double panLeft_ = 1.0, panRight_ = 1.0;
   int fadeSamples_ = 1, fadeLeft_ = 0;

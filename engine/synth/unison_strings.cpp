@@ -1,23 +1,53 @@
 // A key's unison strings: each prepared on its own patch, and struck, released, bent and reset
-// together.
+// together; on a bridge, stepped in turn with it one scheme step at a time.
 #include "synth/unison_strings.h"
+
+#include <algorithm>
+#include <cmath>
 
 namespace hamiltone {
 
-void UnisonStrings::prepare(const Instrument& instrument, int note, double sampleRate) {
-  std::vector<StringVoice> strings(instrument.keys.at(note - instrument.lowestNote).unisons);
-  for (size_t s = 0; s < strings.size(); ++s)
+void UnisonStrings::prepare(const Instrument& instrument, int note, double sampleRate,
+                            int maxBlock) {
+  const StringKey& key = instrument.keys.at(note - instrument.lowestNote);
+  std::vector<StringVoice> strings(key.unisons);
+  double added = 0.0;
+  for (size_t s = 0; s < strings.size(); ++s) {
     strings[s].prepare(unisonPatch(instrument, note, static_cast<int>(s)), note, sampleRate);
+    added += strings[s].coupling().selfStiffness();
+  }
+  const bool bridged = key.bridge.mass > 0.0;
+  Bridge bridge;
+  if (bridged) {
+    const double k = 1.0 / (sampleRate * key.patch.oversampling);
+    // The largest bend raises βT0/h, and with it K_s, by at most the tension range.
+    bridge.prepare(key.bridge, k, added * std::pow(2.0, 2.0 * instrument.bendRange / 12.0));
+  }
   strings_ = std::move(strings);
+  bridge_ = bridge;
+  bridged_ = bridged;
+  for (auto* buffer : {&boardForce_, &scratchLeft_, &scratchRight_})
+    buffer->assign(std::max(maxBlock, 1), 0.0f);
+  quiet_.prepare(sampleRate);
+  reset();
 }
 
 void UnisonStrings::reset() noexcept {
   for (StringVoice& s : strings_) s.reset();
+  bridge_.reset();
+  quiet_.reset();
+  active_ = false;
+  wBefore_ = 0.0;
 }
 
 void UnisonStrings::noteOn(double velocity, bool unaCorda) noexcept {
   const size_t missed = unaCorda && strings_.size() == 3 ? 1 : 0;
+  if (bridged_ && !active_) reset();  // a freed key starts from rest, its bridge too
   for (size_t s = missed; s < strings_.size(); ++s) strings_[s].noteOn(velocity);
+  if (!bridged_) return;
+  for (StringVoice& s : strings_) s.wake();
+  quiet_.strike();
+  active_ = true;
 }
 
 void UnisonStrings::release(double damperScale, double contact) noexcept {
@@ -30,18 +60,108 @@ void UnisonStrings::setBend(double semitones) noexcept {
 
 void UnisonStrings::setQuietFloor(double floor) noexcept {
   for (StringVoice& s : strings_) s.setQuietFloor(floor);
+  quiet_.setFloor(floor < 0.0 ? floor : floor * static_cast<double>(strings_.size()));
 }
 
 bool UnisonStrings::active() const {
+  if (bridged_) return active_;
   for (const StringVoice& s : strings_)
     if (s.active()) return true;
   return false;
 }
 
 int UnisonStrings::guardEvents() const {
-  int events = 0;
+  int events = guardEvents_;
   for (const StringVoice& s : strings_) events += s.guardEvents();
   return events;
+}
+
+double UnisonStrings::energy() const {
+  double e = 0.0;
+  for (const StringVoice& s : strings_) {
+    e += s.energy();
+    if (bridged_)
+      e += s.coupling().energy(s.scheme().q(), s.scheme().qNext(), wBefore_, bridge_.current());
+  }
+  return bridged_ ? e + bridge_.energy() : e;
+}
+
+double UnisonStrings::injectedEnergy() const {
+  double e = 0.0;
+  for (const StringVoice& s : strings_) e += s.injectedEnergy();
+  return e;
+}
+
+void UnisonStrings::process(std::span<float> left, std::span<float> right) noexcept {
+  const size_t n = left.size();
+  frames_ = n;
+  if (bridged_) {
+    processBridged(left, right.subspan(0, n));
+    return;
+  }
+  std::fill(boardForce_.begin(), boardForce_.begin() + n, 0.0f);
+  std::fill(left.begin(), left.end(), 0.0f);
+  std::fill(right.begin(), right.begin() + n, 0.0f);
+  const std::span<float> oneL(scratchLeft_.data(), n), oneR(scratchRight_.data(), n);
+  for (StringVoice& s : strings_) {
+    if (!s.active()) continue;
+    s.process(oneL, oneR);
+    const bool stereo = s.channels() == 2;
+    for (size_t i = 0; i < n; ++i) {
+      left[i] += oneL[i];
+      right[i] += stereo ? oneR[i] : oneL[i];  // a mono string feeds both channels
+    }
+  }
+}
+
+// Per output sample, R scheme steps; each step: every string takes the bridge's w^n, then the
+// bridge takes their pull at q^n (bridge.h). The guard and the quiet check act on the key.
+void UnisonStrings::processBridged(std::span<float> left, std::span<float> right) noexcept {
+  const size_t n = left.size();
+  const bool stereo = channels() == 2;
+  auto silence = [&] {
+    std::fill(left.begin(), left.end(), 0.0f);
+    std::fill(right.begin(), right.end(), 0.0f);
+    std::fill(boardForce_.begin(), boardForce_.begin() + n, 0.0f);
+  };
+  if (!active_) {
+    silence();
+    return;
+  }
+  bool finite = true;
+  for (size_t i = 0; i < n; ++i) {
+    double sum[2] = {0.0, 0.0}, force = 0.0;  // a mono patch leaves sum[1] at 0
+    int steps = 0;
+    for (bool ready = false; !ready;) {
+      const double w = bridge_.current();
+      double pull = 0.0;
+      for (StringVoice& s : strings_) {
+        double out[2] = {0.0, 0.0};
+        ready = s.stepOnBridge(w, out);
+        sum[0] += out[0];
+        sum[1] += out[1];
+        pull += s.pullOnBridge(w);
+      }
+      wBefore_ = w;
+      bridge_.step(pull);
+      force += bridge_.forceOnBoard();
+      ++steps;
+    }
+    left[i] = static_cast<float>(sum[0]);
+    right[i] = static_cast<float>(stereo ? sum[1] : sum[0]);
+    boardForce_[i] = static_cast<float>(force / steps);
+    finite = finite && std::isfinite(sum[0]) && std::isfinite(sum[1]) && std::isfinite(force);
+  }
+  // The guard: a non-finite sample or runaway energy never leaves the key.
+  const double h = energy();
+  const double multiple = strings_.front().patch().guardEnergyMultiple;
+  if (!finite || !std::isfinite(h) || h > multiple * injectedEnergy()) {
+    silence();
+    ++guardEvents_;
+    reset();
+    return;
+  }
+  if (quiet_.update(left, right, n)) active_ = false;
 }
 
 }  // namespace hamiltone

@@ -1,37 +1,63 @@
 // The voice of one key of a string instrument: its 1 to 3 unison strings, a few cents apart,
-// played as one.
+// played as one — each on a rigid end, or all on the key's bridge, which couples them.
 #pragma once
 
 #include <span>
 #include <vector>
 
+#include "instruments/bridge.h"
 #include "synth/instrument.h"
 #include "voices/string_voice.h"
+#include "voices/voice_block.h"
 
 namespace hamiltone {
 
 class UnisonStrings {
  public:
-  // The key's unison strings, each on its unisonPatch(). May allocate; throws
-  // std::invalid_argument naming the patch field (from the voices).
-  void prepare(const Instrument& instrument, int note, double sampleRate);
+  // The key's unison strings, each on its unisonPatch(), and its bridge when the key has one
+  // (bridge mass > 0). May allocate; throws std::invalid_argument naming the patch field (from
+  // the voices and the bridge).
+  void prepare(const Instrument& instrument, int note, double sampleRate, int maxBlock);
   void reset() noexcept;
 
   // unaCorda (the soft pedal, CC67): the action shifted, the hammer misses the first string of a
   // three-string unison and strikes the other two; keys of one or two strings are struck as ever.
+  // On a bridge the missed string rings too, driven through the bridge.
   void noteOn(double velocity, bool unaCorda = false) noexcept;
   void release(double damperScale, double contact) noexcept;
   void setBend(double semitones) noexcept;
   void setQuietFloor(double floor) noexcept;  // each string's: the caller shares it among them
 
+  // Writes (not adds) the key's next left.size() samples (at most maxBlock; right as long): the
+  // strings' pickups summed, a mono patch's on both channels. Never allocates.
+  void process(std::span<float> left, std::span<float> right) noexcept;
+  int channels() const { return strings_.front().channels(); }
+
+  bool bridged() const { return bridged_; }
+  // The force the bridge passed to the soundboard over the last process(), one value per output
+  // sample (the mean over its scheme steps), N; zeros without a bridge.
+  std::span<const float> boardForce() const { return {boardForce_.data(), frames_}; }
+
   bool active() const;  // a string sounds
   int guardEvents() const;
   double fundamentalHz() const { return strings_.front().fundamentalHz(); }  // the first string's
   size_t size() const { return strings_.size(); }
-  std::span<StringVoice> strings() { return strings_; }  // in order, for the key's mix
+  std::span<StringVoice> strings() { return strings_; }
+  // Strings, bridge and coupling: H^{n+½} less the losses' share, J (the guard's, the tests').
+  double energy() const;
+  double injectedEnergy() const;  // by the strikes and the bend, all strings
 
  private:
+  void processBridged(std::span<float> left, std::span<float> right) noexcept;
+
   std::vector<StringVoice> strings_;
+  Bridge bridge_;
+  bool bridged_ = false, active_ = false;  // active_: the bridged key's, as one voice
+  int guardEvents_ = 0;
+  QuietDetector quiet_;  // the bridged key's, on its summed output
+  std::vector<float> boardForce_, scratchLeft_, scratchRight_;
+  size_t frames_ = 0;
+  double wBefore_ = 0.0;  // w^n, for the coupling energy at n+½
 };
 
 }  // namespace hamiltone

@@ -212,6 +212,7 @@ void StringVoice::applyBend() noexcept {
   const double before = energy();
   scheme_->system().string().setTensionScale((root * root - bendOffset_) / bendSlope_);
   scheme_->stiffnessChanged();
+  coupling_ = BridgeCoupling(scheme_->system().string());
   injected_ += energy() - before;
 }
 
@@ -244,6 +245,22 @@ void StringVoice::noteOn(double velocity) noexcept {
   struck_ = parked_ = false;
   quiet_.strike();
   active_ = true;
+}
+
+void StringVoice::wake() noexcept {
+  if (active_) return;
+  reset();
+  quiet_.strike();
+  active_ = true;
+}
+
+bool StringVoice::stepOnBridge(double w, double out[2]) noexcept {
+  scheme_->setPointForce(0, coupling_.lastIndex(), coupling_.forceOnLast(w));
+  scheme_->setPointForce(1, coupling_.lastIndex() - 1, coupling_.forceOnSecond(w));
+  if (!stepAndPick(out)) return false;
+  out[0] *= patch_.gain;
+  out[1] *= patch_.gain;
+  return true;
 }
 
 void StringVoice::release(double damperScale, double contact) noexcept {
@@ -295,6 +312,17 @@ double StringVoice::pickup(const Vector& q, const Vector& qNext, double position
   return (at(qNext) - at(q)) / k_;
 }
 
+bool StringVoice::stepAndPick(double out[2]) noexcept {
+  scheme_->step();
+  catchHammer();
+  const Vector& q = scheme_->q();
+  const Vector& qNext = scheme_->qNext();
+  bool ready = false;
+  for (int c = 0; c < patch_.channels; ++c)
+    ready = decimators_[c].push(pickup(q, qNext, patch_.pickups[c]), out[c]);
+  return ready;
+}
+
 void StringVoice::process(std::span<float> left, std::span<float> right) noexcept {
   // Stereo writes the right channel too, over as many samples as it has; a mono patch leaves it.
   const bool stereo = patch_.channels == 2 && !right.empty();
@@ -306,14 +334,7 @@ void StringVoice::process(std::span<float> left, std::span<float> right) noexcep
   bool finite = true;
   for (size_t i = 0; i < left.size(); ++i) {
     double out[2] = {0.0, 0.0};
-    bool ready = false;
-    while (!ready) {
-      scheme_->step();
-      catchHammer();
-      const Vector& q = scheme_->q();
-      const Vector& qNext = scheme_->qNext();
-      for (int c = 0; c < patch_.channels; ++c)
-        ready = decimators_[c].push(pickup(q, qNext, patch_.pickups[c]), out[c]);
+    while (!stepAndPick(out)) {
     }
     left[i] = static_cast<float>(patch_.gain * out[0]);
     finite = finite && std::isfinite(left[i]);

@@ -6,6 +6,7 @@
 #include <optional>
 #include <span>
 
+#include "instruments/bridge.h"
 #include "instruments/hammer.h"
 #include "instruments/string_tuning.h"
 #include "schemes/sav.h"
@@ -49,8 +50,9 @@ constexpr double kUnresolvedEpsilonShare = 0.01;
 // ½ M_H v_max²: the energy the hardest strike gives the hammer, the voice's energy scale.
 double strikeEnergyScale(const StringPatch& patch);
 
-// σ(ξ) = σ0 + σ1 ξ is the decay rate of a mode of wavenumber² ξ; two T60s fix it (docs/instrument-data.md §3.4):
-// σ0 = 6.908 / T60(0 Hz), σ1 = (6.908 / T60(f) − σ0) / ξ(f), ξ(ω) from c²ξ + κ²ξ² = ω².
+// σ(ξ) = σ0 + σ1 ξ is the decay rate of a mode of wavenumber² ξ; two T60s fix it
+// (docs/instrument-data.md §3.4): σ0 = 6.908 / T60(0 Hz), σ1 = (6.908 / T60(f) − σ0) / ξ(f), ξ(ω)
+// from c²ξ + κ²ξ² = ω².
 struct StringLoss {
   double sigma0 = 0.0;
   double sigma1 = 0.0;
@@ -80,6 +82,17 @@ class StringVoice {
   // min(left, right) samples of right, a mono one leaves right alone. Never allocates.
   void process(std::span<float> left, std::span<float> right) noexcept;
 
+  // On a bridge (UnisonStrings): the key steps its strings and its bridge in turn, one scheme step
+  // at a time. wake() sets a string that was not struck going from rest (una corda's missed
+  // string, which the bridge excites); stepOnBridge() takes one step with the bridge at w — its
+  // pull on the last two nodes — and pushes the pickups, returning true when `out` holds the next
+  // output sample (gain applied); pullOnBridge() is the string's force on the bridge at q^n.
+  void wake() noexcept;
+  bool stepOnBridge(double w, double out[2]) noexcept;
+  double pullOnBridge(double w) const noexcept { return coupling_.forceOnBridge(scheme_->q(), w); }
+  const BridgeCoupling& coupling() const { return coupling_; }
+  const StringPatch& patch() const { return patch_; }
+
   bool active() const { return active_; }
   double energy() const;                               // the scheme's H^{n+½} (ε excluded), J
   double injectedEnergy() const { return injected_; }  // by the strikes and the bend's retensioning
@@ -97,6 +110,7 @@ class StringVoice {
   double pickup(const Vector& q, const Vector& qNext, double position) const;
   void catchHammer() noexcept;
   void applyBend() noexcept;
+  bool stepAndPick(double out[2]) noexcept;  // one scheme step; true when a sample is out
 
   StringPatch patch_;
   std::unique_ptr<SplitSav<HammeredString>> scheme_;
@@ -104,6 +118,7 @@ class StringVoice {
   Decimator decimators_[2];
   QuietDetector quiet_;
   StringLoss loss_;
+  BridgeCoupling coupling_;  // of the string as bent now
   double sampleRate_ = 0.0, k_ = 0.0, fundamental_ = 0.0;
   double bend_ = 0.0, bendSlope_ = 0.0, bendOffset_ = 0.0;  // λ1(β) = bendSlope_·β + bendOffset_
   double injected_ = 0.0, caught_ = 0.0;

@@ -155,7 +155,7 @@ TEST(ClapPlugin, ThePlayersControlsAreHeard) {
   EXPECT_LT(softer.peak(0.05, 0.5), 0.8 * plain.peak(0.05, 0.5));
   const Take ringing = level({param(0.0, kDamperScale, 4.0)}, 64);
   EXPECT_LT(plain.peak(1.45, 1.7), 1e-5);
-  EXPECT_GT(ringing.peak(1.45, 1.7), 1e-3 * ringing.peak(0.05, 0.5));
+  EXPECT_GT(ringing.peak(1.45, 1.7), 3e-4 * ringing.peak(0.05, 0.5));  // −70 dB, over 30 of plain's
 }
 
 // What a session saves comes back in another instance: the parameters, and the two strings — a

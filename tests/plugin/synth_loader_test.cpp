@@ -34,7 +34,7 @@ LoadStatus settled(const SynthLoader& loader) {
 
 TEST(BundledPresets, AreThePresetFilesWithTheirNames) {
   const auto presets = bundledPresets();
-  ASSERT_EQ(presets.size(), 6u);
+  ASSERT_EQ(presets.size(), 7u);
   EXPECT_STREQ(presets[0].file, "grand-piano.toml");  // the default
   EXPECT_STREQ(presets[0].name, "Grand piano");
   for (const BundledPreset& p : presets)
@@ -62,7 +62,7 @@ TEST(BuildSynth, OverridesAreReadAsSetTakesThemAndBadOnesSayWhy) {
     EXPECT_STREQ(e.what(), "overrides: \"a4_Hz\": expected NAME=VALUE");
   }
   EXPECT_THROW(buildSynth({.overrides = "a4_Hz=1000"}), std::exception);
-  EXPECT_THROW(buildSynth({.bundled = 6}), std::invalid_argument);
+  EXPECT_THROW(buildSynth({.bundled = 7}), std::invalid_argument);
   EXPECT_THROW(buildSynth({.file = "/nonexistent/preset.toml"}), std::exception);
 }
 

@@ -54,7 +54,8 @@ Played playNote(const Instrument& instrument, int note, double velocity) {
 
 TEST(BundledPresets, RenderClean) {
   for (const char* name :
-       {"paper-c3-string", "grand-piano", "steel-plate", "gong", "thunder-sheet", "small-cymbal"}) {
+       {"paper-c3-string", "grand-piano", "grand-piano-strings", "steel-plate", "gong",
+        "thunder-sheet", "small-cymbal"}) {
     const Instrument instrument =
         loadPreset(std::string(HAMILTONE_SOURCE_DIR) + "/presets/" + name + ".toml");
     const int lo = instrument.lowestNote, hi = instrument.highestNote;

@@ -228,10 +228,12 @@ TEST(NoAllocation, SynthProcess) {
 }
 
 // The pedals: half-pedalling (CC64 between 20 and 100, moved while keys ring), sostenuto (CC66)
-// catching and letting go, una corda (CC67) on three-string keys, and reset controllers.
+// catching and letting go, una corda (CC67) on three-string keys (one on a bridge), and reset
+// controllers.
 TEST(NoAllocation, SynthPedals) {
   Instrument piano = testing::pianoKeys(48, 52, 4);
   for (StringKey& key : piano.keys) key.unisons = 3;
+  piano.keys[0].bridge = {.mass = 0.05, .stiffness = 1e5, .resistance = 900.0};  // C3 on a bridge
   const SynthEvent events[] = {
       {0, {0xB0, 67, 127}}, {1, {0x90, 48, 100}},  {3, {0x90, 50, 60}},  {5, {0xB0, 66, 127}},
       {9, {0xB0, 64, 90}},  {11, {0x80, 48, 0}},   {20, {0x80, 50, 0}},  {30, {0xB0, 64, 64}},

@@ -1,0 +1,77 @@
+// The bridge's mass–spring–resistance step and its coupling to the strings' last nodes.
+#include "instruments/bridge.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "util/format_number.h"
+
+namespace hamiltone {
+
+BridgeCoupling::BridgeCoupling(const NonlinearString& string) : last_(string.transverseSize() - 1) {
+  const StringPhysics& p = string.physics();
+  const double h = string.spacing();
+  const double tension = string.tensionScale() * p.tension / h;  // βT0/h
+  const double bending = p.young * p.inertia / (h * h * h);      // EI/h³
+  c1_ = -(tension + 2.0 * bending);
+  c2_ = string.transverseSize() >= 2 ? bending : 0.0;  // one node: u_{M−2} is the fixed end
+  self_ = tension + bending;
+}
+
+double BridgeCoupling::energy(const Vector& q, const Vector& qNext, double w, double wNext) const {
+  const Eigen::Index second = last_ > 0 ? last_ - 1 : last_;
+  const double cq = c1_ * q[last_] + c2_ * q[second];
+  const double cqNext = c1_ * qNext[last_] + c2_ * qNext[second];
+  return 0.5 * (cqNext * w + cq * wNext) + 0.5 * self_ * wNext * w;
+}
+
+void Bridge::prepare(const BridgePhysics& p, double k, double addedStiffness) {
+  auto require = [](bool ok, const char* field, double value, const std::string& valid) {
+    if (!ok)
+      throw std::invalid_argument(std::string(field) + " = " + formatNumber(value) + ": must be " +
+                                  valid);
+  };
+  require(std::isfinite(p.mass) && p.mass > 0.0, "bridge_mass_kg", p.mass, "a finite mass > 0 kg");
+  require(std::isfinite(p.stiffness) && p.stiffness >= 0.0, "bridge_stiffness_N_m", p.stiffness,
+          "a finite number >= 0 N/m");
+  require(std::isfinite(p.resistance) && p.resistance >= 0.0, "bridge_resistance_kg_s",
+          p.resistance, "a finite number >= 0 kg/s");
+  // Störmer–Verlet's bound on the bridge's own row, the strings' K_s included.
+  const double stiffest = p.stiffness + addedStiffness;
+  require(k * k * stiffest / p.mass < 4.0, "bridge_mass_kg", p.mass,
+          "above k² (K_b + ΣK_s)/4 = " + formatNumber(k * k * stiffest / 4.0) +
+              " kg at this rate, or the explicit coupling is unstable");
+  physics_ = p;
+  k_ = k;
+  up_ = 1.0 + p.resistance * k / (2.0 * p.mass);
+  down_ = 1.0 - p.resistance * k / (2.0 * p.mass);
+  kkOverM_ = k * k / p.mass;
+  reset();
+}
+
+void Bridge::reset() noexcept {
+  w0_ = w1_ = 0.0;
+  dissipated_ = 0.0;
+}
+
+double Bridge::step(double force) noexcept {
+  const double next =
+      (2.0 * w1_ - down_ * w0_ + kkOverM_ * (force - physics_.stiffness * w1_)) / up_;
+  const double velocity = (next - w0_) / (2.0 * k_);  // δt· w
+  dissipated_ += physics_.resistance * k_ * velocity * velocity;
+  w0_ = w1_;
+  w1_ = next;
+  return next;
+}
+
+double Bridge::energy() const {
+  const double velocity = (w1_ - w0_) / k_;
+  return 0.5 * physics_.mass * velocity * velocity + 0.5 * physics_.stiffness * w1_ * w0_;
+}
+
+double Bridge::forceOnBoard() const {
+  return physics_.stiffness * w1_ + physics_.resistance * (w1_ - w0_) / k_;
+}
+
+}  // namespace hamiltone

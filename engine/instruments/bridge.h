@@ -1,0 +1,81 @@
+// The bridge the strings of a key end on: a mass on a spring with a resistance (the soundboard's
+// driving point, docs/instrument-data.md §5), and the string–bridge coupling that keeps the
+// strings' scheme (38) and the bridge together exactly energy-conserving.
+#pragma once
+
+#include "instruments/string.h"
+#include "schemes/hamiltonian.h"
+
+namespace hamiltone {
+
+struct BridgePhysics {
+  double mass = 0.0;        // M_b, kg
+  double stiffness = 0.0;   // K_b, N/m
+  double resistance = 0.0;  // R_b, kg/s (N per m/s)
+};
+
+// The string's end u_M = w rides on the bridge (moving simply supported end: D2 u = 0 there).
+// The string's K energy h/2 Σ βT0 (D₋u)² + EI h/2 Σ (D2 u)² then holds w in its last segment and
+// its last second difference; the terms with w are
+//   E_c = w (c1 u_{M−1} + c2 u_{M−2}) + ½ K_s w²,
+//   c1 = −(βT0/h + 2 EI/h³),  c2 = EI/h³,  K_s = βT0/h + EI/h³.
+// Taken as the scheme takes K, E_c^{n+½} = ½ (Cᵀu^{n+1} w^n + Cᵀu^n w^{n+1}) + ½ K_s w^{n+1} w^n,
+// the string feels f = −C w^n and the bridge −Cᵀu^n − K_s w^n, and the strings, the bridge and
+// E_c together conserve their energy exactly (less the losses). The bridge's displacement is
+// taken as transverse only (the string's end moves with it; its longitudinal end stays fixed);
+// V' keeps u_M = 0, an error of order w/u, the bridge moving microns where the string moves
+// millimetres.
+class BridgeCoupling {
+ public:
+  BridgeCoupling() = default;
+  // From the string's grid, tension (with its bend β) and stiffness; `lastIndex` is u_{M−1}'s
+  // place in the scheme's q (u comes first: M − 2).
+  explicit BridgeCoupling(const NonlinearString& string);
+
+  double forceOnLast(double w) const { return -c1_ * w; }    // on u_{M−1}
+  double forceOnSecond(double w) const { return -c2_ * w; }  // on u_{M−2}
+  Eigen::Index lastIndex() const { return last_; }
+  // −∂E_c/∂w at level n: the string's pull on the bridge.
+  double forceOnBridge(const Vector& q, double w) const {
+    return -(c1_ * q[last_] + c2_ * q[last_ - 1]) - self_ * w;
+  }
+  // E_c^{n+½} from q^n, q^{n+1}, w^n, w^{n+1}.
+  double energy(const Vector& q, const Vector& qNext, double w, double wNext) const;
+  double selfStiffness() const { return self_; }
+
+ private:
+  Eigen::Index last_ = 0;
+  double c1_ = 0.0, c2_ = 0.0, self_ = 0.0;
+};
+
+// M_b δtt w = −K_b w^n − R_b δt· w + F^n, the resistance centred (as σ0 in (49)):
+//   w^{n+1} = (2 w^n − (1 − R_b k/2M_b) w^{n−1} + (k²/M_b)(F^n − K_b w^n)) / (1 + R_b k/2M_b),
+// H^{n+½} = ½ M_b (δ₊w)² + ½ K_b w^{n+1} w^n, H^{n+½} − H^{n−½} = F^n (w^{n+1} − w^{n−1})/2
+// − R_b k (δt· w)². Levels as the scheme's: after a step it holds w^n and w^{n+1}; the strings'
+// next step takes w^{n+1}, current(), and so does the force of the bridge's next step.
+class Bridge {
+ public:
+  // Throws std::invalid_argument naming the field if a value is not finite and >= 0 (mass > 0),
+  // or if k² (K_b + `addedStiffness`) / M_b >= 4 — the strings' K_s summed: the explicit coupling
+  // would not be stable.
+  void prepare(const BridgePhysics& physics, double k, double addedStiffness);
+  void reset() noexcept;
+
+  double current() const { return w1_; }  // w at the level the next steps' forces use
+  // One step under the force F (the strings' pull, at level current()). Returns w^{n+1}.
+  double step(double force) noexcept;
+
+  double energy() const;  // H^{n+½} of the bridge alone
+  double dissipated() const { return dissipated_; }
+  // What the bridge passes on to the soundboard at the last level: K_b w + R_b ẇ.
+  double forceOnBoard() const;
+  const BridgePhysics& physics() const { return physics_; }
+
+ private:
+  BridgePhysics physics_;
+  double k_ = 0.0, up_ = 1.0, down_ = 1.0, kkOverM_ = 0.0;
+  double w0_ = 0.0, w1_ = 0.0;  // w^n, w^{n+1}
+  double dissipated_ = 0.0;
+};
+
+}  // namespace hamiltone

@@ -1,0 +1,126 @@
+// A key's unison strings on the bridge of the grand piano: the fundamental decays in two stages
+// (Weinreich), una corda's missed string rings through the bridge, and a bridge too light for the
+// explicit coupling is refused naming its field.
+#include "synth/unison_strings.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "presets/preset_loader.h"
+#include "support/test_instruments.h"
+
+namespace hamiltone {
+namespace {
+
+constexpr double kRate = 48000.0;
+constexpr int kBlock = 256;
+
+Instrument grandPiano() {
+  return loadPreset(HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml", {.checkVoices = false});
+}
+
+// The key's left channel for `seconds`.
+std::vector<float> play(UnisonStrings& key, double seconds) {
+  std::vector<float> left, l(kBlock), r(kBlock);
+  while (left.size() < seconds * kRate) {
+    key.process(l, r);
+    left.insert(left.end(), l.begin(), l.end());
+  }
+  return left;
+}
+
+// The level (dB) of the partial at `hz` in 100 ms windows (Goertzel's single-bin DFT).
+std::vector<double> partialLevel(const std::vector<float>& x, double hz) {
+  const size_t window = kRate / 10;
+  std::vector<double> db;
+  for (size_t start = 0; start + window <= x.size(); start += window) {
+    double re = 0.0, im = 0.0;
+    for (size_t i = 0; i < window; ++i) {
+      const double phase = 2.0 * std::numbers::pi * hz * static_cast<double>(i) / kRate;
+      re += x[start + i] * std::cos(phase);
+      im += x[start + i] * std::sin(phase);
+    }
+    db.push_back(10.0 * std::log10(re * re + im * im + 1e-300));
+  }
+  return db;
+}
+
+// dB/s from t0 to t1: the least-squares slope of the level in 100 ms windows, each window's
+// power first averaged with its neighbours over `smooth` seconds (the unisons beat, a few seconds
+// a period in the aftersound: the mean over the beats is what decays).
+double decay(const std::vector<double>& db, double t0, double t1, double smooth) {
+  const int half = static_cast<int>(std::lround(smooth * 5.0));
+  double st = 0.0, sy = 0.0, stt = 0.0, sty = 0.0;
+  int n = 0;
+  for (int i = static_cast<int>(std::lround(t0 * 10.0)); i <= std::lround(t1 * 10.0); ++i) {
+    double power = 0.0;
+    int count = 0;
+    for (int j = std::max(0, i - half); j <= std::min<int>(db.size() - 1, i + half); ++j, ++count)
+      power += std::pow(10.0, db[j] / 10.0);
+    const double t = i / 10.0, y = 10.0 * std::log10(power / count);
+    st += t, sy += y, stt += t * t, sty += t * y, ++n;
+  }
+  return -(n * sty - st * sy) / (n * stt - st * st);
+}
+
+// C4's three strings struck together: the fundamental first drains faster than a single string on
+// the same bridge does (about three times: the in-phase prompt sound), then, once the part of the
+// motion that the detune and the hammer's unequal shares put out of phase is all that is left,
+// slower than the single string (the aftersound, which hardly moves the bridge).
+TEST(UnisonStrings, OnTheBridgeTheFundamentalDecaysInTwoStages) {
+  Instrument piano = grandPiano();
+  UnisonStrings key;
+  key.prepare(piano, 60, kRate, kBlock);
+  ASSERT_TRUE(key.bridged());
+  ASSERT_EQ(key.size(), 3u);
+  key.noteOn(0.7);
+  const std::vector<double> db = partialLevel(play(key, 8.0), key.fundamentalHz());
+  const double prompt = decay(db, 0.1, 0.9, 0.0), after = decay(db, 2.5, 7.5, 1.0);
+  piano.keys[60 - piano.lowestNote].unisons = 1;
+  UnisonStrings one;
+  one.prepare(piano, 60, kRate, kBlock);
+  one.noteOn(0.7);
+  const double single = decay(partialLevel(play(one, 4.0), one.fundamentalHz()), 0.5, 3.5, 0.0);
+  std::printf(
+      "C4 fundamental: prompt %.1f dB/s, aftersound %.1f dB/s; one string alone %.1f dB/s\n",
+      prompt, after, single);
+  EXPECT_GT(prompt, 2.0 * single);
+  EXPECT_LT(after, 0.5 * single);
+  EXPECT_EQ(key.guardEvents(), 0);
+}
+
+// With una corda the hammer misses the first string; on the bridge that string still rings,
+// driven by its neighbours' pull — on rigid ends it stays at rest.
+TEST(UnisonStrings, UnaCordaMissedStringRingsThroughTheBridge) {
+  for (const bool bridged : {true, false}) {
+    Instrument piano = grandPiano();
+    if (!bridged) piano.keys[60 - piano.lowestNote].bridge = {};
+    UnisonStrings key;
+    key.prepare(piano, 60, kRate, kBlock);
+    key.noteOn(0.7, /*unaCorda=*/true);
+    play(key, 0.5);
+    const double missed = key.strings()[0].energy();
+    const double struck = key.strings()[1].energy() + key.strings()[2].energy();
+    if (bridged) {
+      EXPECT_GT(missed, 1e-6 * struck);
+    } else {
+      EXPECT_EQ(missed, 0.0);
+    }
+  }
+}
+
+TEST(UnisonStrings, ABridgeTooLightIsRefusedNamingItsField) {
+  try {
+    loadPreset(HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml",
+               {.overrides = {{"bridge.mass_kg", "1e-6"}}});
+    FAIL() << "a 1 mg bridge was accepted";
+  } catch (const PresetError& e) {
+    EXPECT_NE(std::string(e.what()).find("bridge.mass_kg"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace hamiltone
