@@ -357,6 +357,11 @@ int play(const PlayArguments& a) {
                  finished ? ("played " + score.what + " to the end").c_str()
                           : ("stopped by " + signalName(signal)).c_str(),
                  audio.underruns(), s.late, 100.0 * s.peakLoad, s.guardEvents);
+  if (s.limitedFrames > 0)
+    std::fprintf(stderr,
+                 "hamiltone-play: the master's limiter reduced the gain by up to %.1f dB on %ld "
+                 "frames: lower the volume (CC7) or the preset's gain_dB\n",
+                 s.limiterDeepestDb, s.limitedFrames);
   if (recorder) {
     const double seconds = recorder->finish();
     if (!recorder->failed()) {

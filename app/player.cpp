@@ -105,6 +105,8 @@ void Player::render(float* interleaved, int frames, std::int64_t nowNs) noexcept
   const int voices = synth_.activeVoices();
   voices_.store(voices, std::memory_order_relaxed);
   guard_.store(synth_.guardEvents(), std::memory_order_relaxed);
+  limitedFrames_.store(synth_.limiter().limitedFrames(), std::memory_order_relaxed);
+  limiterDeepestDb_.store(synth_.limiter().deepestReductionDb(), std::memory_order_relaxed);
   if (hasScore_ && nextScored_ == score_.size() && voices == 0 && synth_.silent()) {
     finished_.store(true, std::memory_order_relaxed);
     recordingEnded_ = endRecording_;  // this block was the last one recorded
@@ -163,6 +165,8 @@ Player::Status Player::status() const {
   s.voices = voices_.load();
   s.limit = limitShown_.load();
   s.guardEvents = guard_.load();
+  s.limitedFrames = limitedFrames_.load();
+  s.limiterDeepestDb = limiterDeepestDb_.load();
   s.load = load_.load();
   s.peakLoad = peak_.load();
   s.recordDropped = recordDropped_.load();

@@ -61,6 +61,8 @@ class Player {
     std::uint32_t lastMessage = 0;  // status << 16 | data1 << 8 | data2; 0 before any
     long limitDrops = 0;            // times the protection lowered the limit
     double dropLoad = 0.0;          // the highest load of the blocks that made it drop last
+    long limitedFrames = 0;         // frames the master's limiter reduced (0: it never acted)
+    double limiterDeepestDb = 0.0;  // and by how much at most, in dB
     // The score has been played to its last message (at once for an empty one) and no key sounds
     // any more, nor fades out (false with no score).
     bool finished = false;
@@ -94,7 +96,8 @@ class Player {
   double reliefTime_ = 0.0, holdTime_ = 0.0, runPeak_ = 0.0;
   std::atomic<int> voices_{0}, limitShown_{0}, guard_{0};
   std::atomic<double> load_{0.0}, peak_{0.0}, dropLoad_{0.0};
-  std::atomic<long> recordDropped_{0}, late_{0}, drops_{0};
+  std::atomic<long> recordDropped_{0}, late_{0}, drops_{0}, limitedFrames_{0};
+  std::atomic<double> limiterDeepestDb_{0.0};
   std::atomic<bool> finished_{false};
   std::atomic<std::uint32_t> last_{0};
   pthread_t callbackThread_{};  // written once, before callbackKnown_

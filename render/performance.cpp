@@ -87,6 +87,10 @@ RenderStats renderPerformance(Synth& synth, const std::vector<TimedMessage>& mes
   stats.nonFinite = synth.nonFiniteSamples();
   stats.steals = synth.steals();
   stats.loudestSteal = synth.loudestSteal();
+  stats.limitedFrames = synth.limiter().limitedFrames();
+  stats.overFrames = synth.limiter().overFrames();
+  stats.limiterDeepestDb = synth.limiter().deepestReductionDb();
+  stats.peakBeforeLimiter = synth.limiter().peakIn();
   return stats;
 }
 

@@ -20,6 +20,10 @@ struct RenderStats {
   float peak = 0.0f;          // largest |sample| written
   long steals = 0;            // keys the voice limit took (Synth::steals)
   double loudestSteal = 0.0;  // the loudest of them under its own peak (Synth::loudestSteal)
+  // The master's limiter (Synth::limiter): frames it reduced, frames over its ceiling, its
+  // deepest gain reduction, and the largest |sample| that entered it.
+  long limitedFrames = 0, overFrames = 0;
+  double limiterDeepestDb = 0.0, peakBeforeLimiter = 0.0;
 };
 
 // What an unstable render did and why it is refused: per instrument (by its preset file), the

@@ -89,4 +89,24 @@ std::string stealSummary(long steals, double loudestLevel, int limit) {
   return text;
 }
 
+std::string limiterSummary(long limitedFrames, long overFrames, double deepestReductionDb,
+                           double peakIn, double ceiling, double sampleRate) {
+  char text[200];
+  const double peakDb = peakIn > 0.0 ? 20.0 * std::log10(peakIn) : -INFINITY;
+  const double ceilingDb = 20.0 * std::log10(ceiling);
+  if (limitedFrames == 0) {
+    std::snprintf(text, sizeof text,
+                  "peak %.1f dBFS before the limiter, %.1f dB under its ceiling of %.2f dBFS: it "
+                  "did not act",
+                  peakDb, ceilingDb - peakDb, ceilingDb);
+    return text;
+  }
+  std::snprintf(text, sizeof text,
+                "the limiter reduced the gain by up to %.1f dB on %ld frames (%.3f s; %ld over its "
+                "ceiling of %.2f dBFS); peak before it %+.1f dBFS",
+                deepestReductionDb, limitedFrames, static_cast<double>(limitedFrames) / sampleRate,
+                overFrames, ceilingDb, peakDb);
+  return text;
+}
+
 }  // namespace hamiltone::cli

@@ -42,4 +42,11 @@ std::string renderSummary(double renderedSeconds, double wallSeconds);
 // stolen at the limit of 64 voices". `loudestLevel` is Synth::loudestSteal() (1 is the peak).
 std::string stealSummary(long steals, double loudestLevel, int limit);
 
+// What the master's limiter (PeakLimiter) did to a render: "peak -2.4 dBFS before the limiter,
+// 2.2 dB under its ceiling of -0.18 dBFS: it did not act", or "the limiter reduced the gain by
+// up to 3.1 dB on 5120 frames (0.107 s; 12 over its ceiling of -0.18 dBFS); peak before it
+// +2.9 dBFS". `peakIn` is linear (1 is 0 dBFS).
+std::string limiterSummary(long limitedFrames, long overFrames, double deepestReductionDb,
+                           double peakIn, double ceiling, double sampleRate);
+
 }  // namespace hamiltone::cli

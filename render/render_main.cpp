@@ -133,6 +133,10 @@ int run(const RenderArguments& a) {
                  renderSummary(stats.seconds, stats.wallSeconds).c_str());
     std::fprintf(stderr, "hamiltone-render: %s\n",
                  stealSummary(stats.steals, stats.loudestSteal, synth.polyphony()).c_str());
+    std::fprintf(stderr, "hamiltone-render: %s\n",
+                 limiterSummary(stats.limitedFrames, stats.overFrames, stats.limiterDeepestDb,
+                                stats.peakBeforeLimiter, MasterBus::kCeiling, rate)
+                     .c_str());
   }
   return 0;
 }

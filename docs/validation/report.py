@@ -40,6 +40,7 @@ SECTIONS = [
     # ------------------------------------------------------------------------------------------
     "instrument",    # the synthesizer: piano brightness, inharmonicity, pitch glide, gong
     "string_grids",  # the string's grid rules on the piano: glide, phantom partials, cost
+    "dynamics",      # loudness across velocity and register; the fortissimo passage's headroom
 ]
 
 

@@ -98,6 +98,10 @@ void buildStringKeys(const PresetValues& values, Instrument& instrument) {
     p.t60Low = at("loss.t60_low_s");
     p.t60High = at("loss.t60_high_s");
     p.damperT60 = at("loss.damper_t60_s");
+    p.gain = at("pickups.gain");
+    p.velocityMin = at("hammer.velocity_min_m_s");
+    p.velocityMax = at("hammer.velocity_max_m_s");
+    p.velocityCurve = at("hammer.velocity_curve");
     key.unisons = static_cast<int>(at("string.unisons"));
     key.detuneCents = at("string.detune_cents");
     key.bridge = {.mass = at("bridge.mass_kg"),

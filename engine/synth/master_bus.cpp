@@ -1,6 +1,6 @@
 // The master section, sample by sample: one-pole smoothing of the volume, a 5 Hz DC blocker, and
-// a stereo-linked peak limiter with instant attack (so its ceiling is never crossed) and an
-// exponential release; a final clamp and a non-finite check make the bound unconditional.
+// the peak limiter (master_bus.h); a final clamp and a non-finite check make the bound
+// unconditional even for a limiter fed a value it cannot reduce (an infinity is zeroed first).
 #include "synth/master_bus.h"
 
 #include <algorithm>
@@ -8,17 +8,38 @@
 
 namespace hamiltone {
 
+void PeakLimiter::prepare(double sampleRate) {
+  hold_ = std::lround(kHoldS * sampleRate);
+  release_ = 1.0 - std::exp(-1.0 / (kReleaseS * sampleRate));
+  reset();
+  clearMeters();
+}
+
+void PeakLimiter::reset() {
+  gain_ = 1.0;
+  holdLeft_ = 0;
+}
+
+void PeakLimiter::clearMeters() {
+  over_ = limited_ = 0;
+  deepest_ = 1.0;
+  peakIn_ = 0.0;
+}
+
+double PeakLimiter::deepestReductionDb() const { return -20.0 * std::log10(deepest_); }
+
 void MasterBus::prepare(double sampleRate) {
   smoothing_ = 1.0 - std::exp(-1.0 / (kSmoothingS * sampleRate));
-  release_ = 1.0 - std::exp(-1.0 / (kReleaseS * sampleRate));
   for (DcBlocker& d : dc_) d.prepare(kDcCornerHz, sampleRate);
+  limiter_.prepare(sampleRate);
+  nonFinite_ = 0;
   reset();
 }
 
 void MasterBus::reset() {
   for (DcBlocker& d : dc_) d.reset();
   volume_ = volumeTarget_;
-  limiter_ = 1.0;
+  limiter_.reset();
 }
 
 void MasterBus::process(std::span<float> left, std::span<float> right) noexcept {
@@ -32,11 +53,9 @@ void MasterBus::process(std::span<float> left, std::span<float> right) noexcept 
       }
       x[c] = volume_ * dc_[c].process(x[c]);
     }
-    const double peak = std::max(std::abs(x[0]), std::abs(x[1]));
-    const double wanted = peak > kCeiling ? kCeiling / peak : 1.0;
-    limiter_ = std::min(wanted, limiter_ + release_ * (1.0 - limiter_));
-    left[i] = static_cast<float>(std::clamp(limiter_ * x[0], -1.0, 1.0));
-    right[i] = static_cast<float>(std::clamp(limiter_ * x[1], -1.0, 1.0));
+    limiter_.process(x[0], x[1]);
+    left[i] = static_cast<float>(std::clamp(x[0], -1.0, 1.0));
+    right[i] = static_cast<float>(std::clamp(x[1], -1.0, 1.0));
   }
 }
 

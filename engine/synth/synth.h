@@ -86,6 +86,8 @@ class Synth {
   int program() const { return program_; }
   int guardEvents() const;
   long nonFiniteSamples() const { return master_.nonFinite(); }
+  // The master's limiter and its meters since prepare(): how often and how deep it acted.
+  const PeakLimiter& limiter() const { return master_.limiter(); }
   int threads() const { return pool_ ? pool_->threads() : 1; }
   // The worker threads take this scheduling policy and priority (see WorkerPool::schedule).
   bool scheduleWorkers(int policy, int priority) noexcept {

@@ -219,6 +219,28 @@ TEST(PresetLoader, CrossFieldBoundsHoldAtEveryKey) {
                           "at most 6 (hammer.velocity_max_m_s)"));
 }
 
+// The dynamics calibration (docs/instrument-data.md §5.4) varies the velocity law and the pickups'
+// gain per key: anchors set them, linearly between (their bounds reach 0 or below), held beyond;
+// and velocity_max must stay at least velocity_min at every key.
+TEST(PresetLoader, VelocityLawAndPickupGainVaryPerKey) {
+  const Instrument i = parsePreset(kStringHead +
+                                       "[hammer]\nvelocity_curve = 2\n[pickups]\ngain = 0.025\n"
+                                       "[[key]]\nnote = \"C2\"\npickups.gain = 0.1\n"
+                                       "hammer.velocity_min_m_s = 1.0\n"
+                                       "[[key]]\nnote = \"C4\"\npickups.gain = 0.02\n",
+                                   "test.toml");
+  EXPECT_EQ(i.keys[0].patch.gain, 0.1);
+  EXPECT_NEAR(i.keys[48 - 36].patch.gain, 0.06, 1e-15);
+  EXPECT_EQ(i.keys[60 - 36].patch.gain, 0.02);
+  for (const StringKey& key : i.keys) {
+    EXPECT_EQ(key.patch.velocityMin, 1.0);
+    EXPECT_EQ(key.patch.velocityMax, 6.0);
+    EXPECT_EQ(key.patch.velocityCurve, 2.0);
+  }
+  EXPECT_THAT(errorsOfText(kStringHead + "[[key]]\nnote = \"C3\"\nhammer.velocity_max_m_s = 0.4\n"),
+              ElementsAre(HasSubstr("key[C3].hammer.velocity_max_m_s = 0.4: out of range")));
+}
+
 TEST(PresetLoader, AnchorsScaleGeometricallyLinearlyOrStepwise) {
   const Instrument i = parsePreset(kStringHead +
                                        "[string]\nlength_m = 1.5\n"

@@ -11,6 +11,7 @@
 
 namespace {
 
+using hamiltone::cli::limiterSummary;
 using hamiltone::cli::ProgressBar;
 using hamiltone::cli::renderSummary;
 using hamiltone::cli::stealSummary;
@@ -53,6 +54,16 @@ TEST(RenderSummary, StealsWithTheLoudestInDecibels) {
             "1 key stolen at the limit of 64 voices, the loudest at -60.0 dB of its own peak");
   EXPECT_EQ(stealSummary(12, 0.5, 16),
             "12 keys stolen at the limit of 16 voices, the loudest at -6.0 dB of its own peak");
+}
+
+// The limiter's line: the headroom when it did not act, what it did when it did.
+TEST(RenderSummary, LimiterHeadroomOrWhatItDid) {
+  EXPECT_EQ(limiterSummary(0, 0, 0.0, 0.5, 0.98, 48000.0),
+            "peak -6.0 dBFS before the limiter, 5.8 dB under its ceiling of -0.18 dBFS: it did "
+            "not act");
+  EXPECT_EQ(limiterSummary(4800, 12, 3.1, 1.4, 0.98, 48000.0),
+            "the limiter reduced the gain by up to 3.1 dB on 4800 frames (0.100 s; 12 over its "
+            "ceiling of -0.18 dBFS); peak before it +2.9 dBFS");
 }
 
 TEST(ProgressBar, DisabledWritesNothing) {

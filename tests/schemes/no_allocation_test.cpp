@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cmath>
 #include <cstdlib>
 #include <new>
 #include <numbers>
@@ -196,6 +197,26 @@ TEST(NoAllocation, PlateVoiceProcess) {
   forbidAllocation(false);
   EXPECT_EQ(forbiddenNews - before, 0);
   EXPECT_EQ(voice.guardEvents(), 0);
+}
+
+// The master bus with its limiter acting — attack, hold, release, the meters, non-finite input —
+// allocates nothing (it runs in every render path, the live player's callback among them).
+TEST(NoAllocation, MasterBusLimiting) {
+  MasterBus bus;
+  bus.prepare(48000.0);
+  std::vector<float> left(4800), right(4800);
+  for (size_t n = 0; n < left.size(); ++n) {
+    left[n] = n < 2400 ? 4.0f * std::sin(0.05f * static_cast<float>(n)) : 0.1f;
+    right[n] = n == 100 ? NAN : -left[n];
+  }
+  const long before = forbiddenNews;
+  forbidAllocation(true);
+  for (int block = 0; block < 10; ++block) bus.process(left, right);
+  const double db = bus.limiter().deepestReductionDb();
+  forbidAllocation(false);
+  EXPECT_EQ(forbiddenNews - before, 0);
+  EXPECT_GT(bus.limiter().limitedFrames(), 0);
+  EXPECT_GT(db, 0.0);
 }
 
 // The synthesizer (prepared with blocks of 256) plays the events, then blocks of several sizes (1
