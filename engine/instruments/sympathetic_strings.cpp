@@ -1,0 +1,309 @@
+// The sympathetic strings: partials, losses and dampers, the coupling (Y1)–(Y5) and the check (Y6).
+#include "instruments/sympathetic_strings.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+#include "instruments/piano_scale.h"
+#include "util/format_number.h"
+
+namespace hamiltone {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kLn1000 = 6.907755278982137;  // T60 = ln(1000)/σ
+
+void requireKeyPositive(int key, const char* name, double value, const char* unit,
+                        bool infinite = false) {
+  if (!(value > 0.0) || (std::isinf(value) && !infinite))
+    throw std::invalid_argument(
+        "sympathetic key " + std::to_string(key) + " " + name + " = " + formatNumber(value) +
+        ": must be " + (infinite ? "> 0 or +inf (" : "a finite number > 0 (") + unit + ")");
+}
+
+// ξ(ω), the wavenumber² of the stiff string's mode at ω: c²ξ + c² B L²/π² ξ² = ω², c = 2 f0 L
+// (docs/instrument-data.md §3.4).
+double wavenumber2(const SympatheticKey& s, double omega) {
+  const double c2 = 4.0 * s.f0 * s.f0 * s.length * s.length;
+  const double kappa2 = c2 * s.inharmonicityB * s.length * s.length / (kPi * kPi);
+  if (kappa2 == 0.0) return omega * omega / c2;
+  return (-c2 + std::sqrt(c2 * c2 + 4.0 * kappa2 * omega * omega)) / (2.0 * kappa2);
+}
+
+}  // namespace
+
+void SympatheticStrings::prepare(std::span<const SympatheticKey> keys, const Soundboard& board,
+                                 double sampleRate, double maxHz, int maxPartials) {
+  if (static_cast<int>(keys.size()) != board.points())
+    throw std::invalid_argument("sympathetic keys = " + std::to_string(keys.size()) +
+                                ": must be one per soundboard bridge point (" +
+                                std::to_string(board.points()) + ")");
+  if (!std::isfinite(sampleRate) || sampleRate <= 0.0)
+    throw std::invalid_argument("sympathetic sample rate = " + formatNumber(sampleRate) +
+                                ": must be a finite number > 0 (Hz)");
+  if (!(maxHz > 0.0 && maxHz < sampleRate / 4.0))  // (Y6): k² ω̂² < 2 ⇔ f < fs/4
+    throw std::invalid_argument("sympathetic maxHz = " + formatNumber(maxHz) + ": must be in (0, " +
+                                formatNumber(sampleRate / 4.0) + ") Hz, below fs/4");
+  if (maxPartials < 1)
+    throw std::invalid_argument("sympathetic maxPartials = " + std::to_string(maxPartials) +
+                                ": must be >= 1");
+  for (int i = 0; i < static_cast<int>(keys.size()); ++i) {
+    const SympatheticKey& s = keys[i];
+    requireKeyPositive(i, "f0", s.f0, "Hz");
+    requireKeyPositive(i, "linearDensity", s.linearDensity, "kg/m");
+    requireKeyPositive(i, "length", s.length, "m");
+    requireKeyPositive(i, "tension", s.tension, "N");
+    requireKeyPositive(i, "t60Low", s.t60Low, "s", true);
+    requireKeyPositive(i, "t60High", s.t60High, "s", true);
+    requireKeyPositive(i, "t60HighHz", s.t60HighHz, "Hz");
+    requireKeyPositive(i, "damperT60", s.damperT60, "s", true);
+    if (!(s.inharmonicityB >= 0.0 && s.inharmonicityB < 1.0))
+      throw std::invalid_argument("sympathetic key " + std::to_string(i) + " inharmonicityB = " +
+                                  formatNumber(s.inharmonicityB) + ": must be in [0, 1)");
+    if (s.unisons < 1 || s.unisons > 4)
+      throw std::invalid_argument("sympathetic key " + std::to_string(i) +
+                                  " unisons = " + std::to_string(s.unisons) + ": must be 1 … 4");
+  }
+
+  data_.assign(keys.begin(), keys.end());
+  k_ = 1.0 / sampleRate;
+  const int keyCount = static_cast<int>(keys.size());
+  first_.assign(keyCount + 1, 0);
+  std::vector<double> mass, stiffness, omega, sigma, coupling;
+  std::vector<int> owner;
+  kappaOn_.resize(keyCount);
+  for (int key = 0; key < keyCount; ++key) {
+    const SympatheticKey& s = keys[key];
+    const double u = s.unisons;
+    const double sigma0 = kLn1000 / s.t60Low;
+    const double sigma1 =
+        std::max(0.0, (kLn1000 / s.t60High - sigma0) / wavenumber2(s, 2.0 * kPi * s.t60HighHz));
+    double kappa = u * s.tension / s.length;  // (Y2): the static T/L per string
+    for (int n = 1; n <= maxPartials; ++n) {
+      const double fn = n * s.f0 * std::sqrt(1.0 + s.inharmonicityB * n * n);
+      if (fn > maxHz) break;
+      const double nu = n * kPi / s.length;
+      const double m = u * s.linearDensity * s.length / 2.0;  // (Y1)
+      const double sn = std::sin(kPi * fn * k_);              // sin(ωk/2)
+      const double kHat = m * 4.0 * sn * sn / (k_ * k_);      // K̂_n
+      const double c =
+          u * ((n % 2) ? -1.0 : 1.0) * nu * s.tension * (1.0 + s.inharmonicityB * n * n);
+      kappa += c * c / kHat;  // (Y2)
+      mass.push_back(m);
+      stiffness.push_back(kHat);
+      omega.push_back(2.0 * kPi * fn);
+      sigma.push_back(sigma0 + sigma1 * nu * nu);  // σ0 + σ1 ξ_n, ξ_n = (nπ/L)²
+      coupling.push_back(c);
+      owner.push_back(key);
+    }
+    first_[key + 1] = static_cast<int>(mass.size());
+    kappaOn_[key] = kappa;
+  }
+
+  // (Y6): the board with the strings' springs, λmax(K̂/M + Φᵀκ Φ/M).
+  const Eigen::MatrixXd& phi = board.shapes();  // modes × points
+  Eigen::MatrixXd a = phi * kappaOn_.asDiagonal() * phi.transpose() / board.modalMass();
+  for (int i = 0; i < board.modes(); ++i) a(i, i) += board.modeStiffness(i) / board.modalMass();
+  const double lambda = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(a, Eigen::EigenvaluesOnly)
+                            .eigenvalues()
+                            .maxCoeff();
+  if (!(lambda * k_ * k_ < 2.0))
+    throw std::invalid_argument(
+        "sympathetic strings: the stiffness they add at the bridge (largest kappa " +
+        formatApprox(kappaOn_.maxCoeff()) +
+        " N/m) makes k^2 lambda_max = " + formatApprox(lambda * k_ * k_) +
+        ": must be < 2 for stability (fewer partials, a lower maxHz or a higher sample rate)");
+
+  const auto vec = [](const std::vector<double>& v) {
+    return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
+  };
+  mass_ = vec(mass);
+  stiffness_ = vec(stiffness);
+  omega_ = vec(omega);
+  sigmaOwn_ = vec(sigma);
+  cOn_ = vec(coupling);
+  key_ = owner;
+  const Eigen::Index total = mass_.size();
+  sigma_.resize(total);
+  c_ = cOn_;
+  kappa_ = kappaOn_;
+  a1_.resize(total);
+  a2_.resize(total);
+  a3_.resize(total);
+  b_.resize(total);
+  bPrev_.resize(total);
+  contact_.assign(keyCount, 0.0);
+  excluded_.assign(keyCount, 0);
+  for (int key = 0; key < keyCount; ++key) setCoefficients(key);
+  reset();
+}
+
+void SympatheticStrings::reset() noexcept {
+  b_.setZero();
+  bPrev_.setZero();
+  dissipated_ = 0.0;
+}
+
+void SympatheticStrings::setCoefficients(int key) noexcept {
+  const SympatheticKey& s = data_[key];
+  const double c = contact_[key];
+  const double damper = std::isinf(s.damperT60) ? 0.0 : kLn1000 / s.damperT60;
+  for (int j = first_[key]; j < first_[key + 1]; ++j) {
+    // The damper blends the decay rate: (1 − c) σ_own + c σ_damper (T60 = damperT60 at c = 1).
+    const double sigma =
+        std::isinf(s.damperT60) ? sigmaOwn_[j] : (1.0 - c) * sigmaOwn_[j] + c * damper;
+    sigma_[j] = sigma;
+    const double damp = 1.0 + sigma * k_;  // (Y3) solved for a^{n+1}
+    a1_[j] = (2.0 - stiffness_[j] * k_ * k_ / mass_[j]) / damp;
+    a2_[j] = (1.0 - sigma * k_) / damp;
+    a3_[j] = k_ * k_ / (mass_[j] * damp);
+  }
+}
+
+void SympatheticStrings::setDamper(int key, double contact) noexcept {
+  contact_[key] = std::clamp(std::isnan(contact) ? 1.0 : contact, 0.0, 1.0);
+  setCoefficients(key);
+}
+
+double SympatheticStrings::keyEnergy(int key) const noexcept {
+  double h = 0.0;
+  for (int j = first_[key]; j < first_[key + 1]; ++j) {
+    const double d = (b_[j] - bPrev_[j]) / k_;
+    h += 0.5 * (mass_[j] * d * d + stiffness_[j] * b_[j] * bPrev_[j]);
+  }
+  return h;
+}
+
+// Key k's share of (Y5), w = w^{n+1}, wPrev = w^n.
+double SympatheticStrings::keyCoupling(int key, double w, double wPrev) const noexcept {
+  double h = 0.5 * kappa_[key] * w * wPrev;
+  for (int j = first_[key]; j < first_[key + 1]; ++j)
+    h += 0.5 * c_[j] * (b_[j] * wPrev + bPrev_[j] * w);
+  return h;
+}
+
+double SympatheticStrings::setExcluded(int key, bool excluded, const Eigen::VectorXd& w,
+                                       const Eigen::VectorXd& wPrev) noexcept {
+  if (excluded == (excluded_[key] != 0)) return 0.0;
+  const double before = keyEnergy(key) + keyCoupling(key, w[key], wPrev[key]);
+  excluded_[key] = excluded;
+  kappa_[key] = excluded ? 0.0 : kappaOn_[key];
+  for (int j = first_[key]; j < first_[key + 1]; ++j) {
+    c_[j] = excluded ? 0.0 : cOn_[j];
+    // Back at rest on the board: the static shape u = w x/L, a_n = −C_n w/K̂_n.
+    b_[j] = excluded ? 0.0 : -c_[j] * w[key] / stiffness_[j];
+    bPrev_[j] = excluded ? 0.0 : -c_[j] * wPrev[key] / stiffness_[j];
+  }
+  return keyEnergy(key) + keyCoupling(key, w[key], wPrev[key]) - before;
+}
+
+void SympatheticStrings::addBoardForces(const Eigen::VectorXd& w,
+                                        std::span<double> forces) const noexcept {
+  const int keyCount = keys();
+  const double* b = b_.data();
+  const double* c = c_.data();
+  for (int key = 0; key < keyCount; ++key) {
+    double f = -kappa_[key] * w[key];  // (Y4)
+    const int end = first_[key + 1];
+#pragma omp simd reduction(- : f)
+    for (int j = first_[key]; j < end; ++j) f -= c[j] * b[j];
+    forces[key] += f;
+  }
+}
+
+void SympatheticStrings::step(const Eigen::VectorXd& w) noexcept {
+  const int keyCount = keys();
+  const double* a1 = a1_.data();
+  const double* a2 = a2_.data();
+  const double* a3 = a3_.data();
+  const double* c = c_.data();
+  const double* sigma = sigma_.data();
+  const double* mass = mass_.data();
+  const double* b = b_.data();
+  double* prev = bPrev_.data();  // a^{n−1} in, a^{n+1} out
+  double lost = 0.0;
+  for (int key = 0; key < keyCount; ++key) {
+    const double wk = w[key];
+    const int end = first_[key + 1];
+#pragma omp simd reduction(+ : lost)
+    for (int j = first_[key]; j < end; ++j) {
+      const double next = a1[j] * b[j] - a2[j] * prev[j] - a3[j] * c[j] * wk;  // (Y3)
+      const double d = next - prev[j];
+      lost += mass[j] * sigma[j] * d * d;
+      prev[j] = next;
+    }
+  }
+  dissipated_ += lost / (2.0 * k_);  // k 2Mσ (δt· a)²
+  b_.swap(bPrev_);
+}
+
+double SympatheticStrings::energy(const Eigen::VectorXd& w,
+                                  const Eigen::VectorXd& wPrev) const noexcept {
+  double h = 0.0;
+  for (int key = 0; key < keys(); ++key) h += keyEnergy(key) + keyCoupling(key, w[key], wPrev[key]);
+  return h;
+}
+
+double SympatheticStrings::partialHz(int key, int n) const noexcept {
+  return omega_[first_[key] + n - 1] / (2.0 * kPi);
+}
+
+}  // namespace hamiltone
+
+namespace hamiltone {
+
+namespace {
+
+// docs/instrument-data.md §3.2: MIDI, single-string T60 (s, unused here: it holds the board's
+// loss too), T60 after release (s; 0: none).
+constexpr double kDecay[][3] = {
+    {21, 40.0, 1.73}, {24, 40.0, 1.65}, {28, 40.0, 1.48}, {29, 10.0, 1.44}, {33, 10.0, 1.24},
+    {36, 10.0, 1.12}, {40, 9.9, 0.92},  {45, 9.2, 0.73},  {48, 8.6, 0.63},  {52, 8.6, 0.58},
+    {57, 8.4, 0.53},  {60, 8.2, 0.51},  {64, 7.9, 0.46},  {69, 7.6, 0.40},  {72, 7.5, 0.37},
+    {76, 7.0, 0.38},  {81, 6.4, 0.44},  {84, 6.0, 0.55},  {88, 5.4, 1.74},  {89, 5.3, 0.0},
+    {93, 4.7, 0.0},   {96, 4.3, 0.0},   {99, 4.0, 0.0},   {108, 4.0, 0.0}};
+
+double interpolated(int note, int column) {
+  const int rows = sizeof kDecay / sizeof kDecay[0];
+  for (int i = 1; i < rows; ++i)
+    if (note <= kDecay[i][0]) {
+      const double t = (note - kDecay[i - 1][0]) / (kDecay[i][0] - kDecay[i - 1][0]);
+      return kDecay[i - 1][column] + t * (kDecay[i][column] - kDecay[i - 1][column]);
+    }
+  return kDecay[rows - 1][column];
+}
+
+}  // namespace
+
+std::vector<SympatheticKey> grandSympatheticKeys(int lowestNote, int highestNote) {
+  std::vector<SympatheticKey> keys;
+  for (int note = lowestNote; note <= highestNote; ++note) {
+    const StringPhysics s = pianoString(note);  // throws outside 21 … 108
+    SympatheticKey key;
+    key.f0 = equalTemperament(note);
+    key.linearDensity = s.linearDensity();
+    key.length = s.length;
+    key.tension = s.tension;
+    key.inharmonicityB = kPi * kPi * s.young * s.inertia / (s.tension * s.length * s.length);
+    key.unisons = note <= 28 ? 1 : note <= 33 ? 2 : 3;  // §1.4
+    // The string's own loss, RT-425's law (§2.1): the board's share comes from the coupling, so
+    // §3.2's whole-instrument T60s would count it twice.
+    const int i = note - 20;
+    const double ru = std::max(0.0, 5e-3 * i - 0.015), eta = 2.78e-11 * i + 1.5274e-9;
+    const double omegaHigh = 2.0 * kPi * key.t60HighHz;
+    key.t60Low = ru > 0.0 ? kLn1000 / ru : std::numeric_limits<double>::infinity();
+    key.t60High = kLn1000 / (ru + eta * omegaHigh * omegaHigh);
+    // From F6 (89) up there is no damper (§3.2, CLM).
+    key.damperT60 = note >= 89 ? std::numeric_limits<double>::infinity() : interpolated(note, 2);
+    keys.push_back(key);
+  }
+  return keys;
+}
+
+}  // namespace hamiltone

@@ -1,0 +1,261 @@
+// The sympathetic strings on the soundboard (PianoBody): the coupled system's energy balance to
+// roundoff, the strings' resonance through the board with the dampers lifted and down, exclusion
+// of a played key, and the stability check (Y6).
+#include "instruments/sympathetic_strings.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <random>
+#include <stdexcept>
+#include <vector>
+
+#include "instruments/piano_body.h"
+
+namespace hamiltone {
+namespace {
+
+constexpr double kRate = 48000.0;
+constexpr double kPi = std::numbers::pi;
+constexpr int kA0 = 21;
+
+PianoBody preparedBody(std::vector<SympatheticKey> keys, const PianoBodySpec& spec = {}) {
+  PianoBody body;
+  body.prepare(spec, bridgeLine(21, 108, spec.board), keys);
+  return body;
+}
+
+std::vector<SympatheticKey> lossless(std::vector<SympatheticKey> keys) {
+  for (auto& k : keys) k.t60Low = k.t60High = std::numeric_limits<double>::infinity();
+  return keys;
+}
+
+// Runs `steps` with a random force on a few keys for the first third; returns the worst
+// |H + dissipated − supplied| over the largest of |H|, dissipated, supplied.
+double balanceResidual(PianoBody& body, int steps, double* scaleOut = nullptr) {
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> force(0.0, 10.0);
+  std::vector<double> f(body.keys(), 0.0);
+  double scale = 0.0, worst = 0.0;
+  for (int n = 0; n < steps; ++n) {
+    for (int k : {5, 27, 39, 51, 80}) f[k] = n < steps / 3 ? force(rng) : 0.0;
+    body.step(f);
+    const double h = body.energy();
+    scale = std::max({scale, std::abs(h), body.dissipated(), body.supplied()});
+    worst = std::max(worst, std::abs(h + body.dissipated() - body.supplied()));
+  }
+  if (scaleOut) *scaleOut = scale;
+  return worst / scale;
+}
+
+TEST(SympatheticStrings, PartialsAreTheStiffStrings) {
+  const auto keys = grandSympatheticKeys();
+  const PianoBody body = preparedBody(keys);
+  const SympatheticStrings& s = body.strings();
+  ASSERT_EQ(s.keys(), 88);
+  for (int key : {0, 39, 60, 75, 87}) {
+    ASSERT_GE(s.partials(key), 1);
+    for (int n = 1; n <= s.partials(key); ++n) {
+      const double expected = n * keys[key].f0 * std::sqrt(1 + keys[key].inharmonicityB * n * n);
+      EXPECT_NEAR(s.partialHz(key, n), expected, 1e-12 * expected);
+      EXPECT_LE(s.partialHz(key, n), 4500.0);
+    }
+  }
+  EXPECT_EQ(s.partials(0), 16);  // A0: the cap
+}
+
+// Board + strings, dampers lifted, lossy: the balance of (S3) with (Y5) holds to roundoff.
+TEST(SympatheticStrings, CoupledEnergyBalanceDampersLiftedToRoundoff) {
+  PianoBody body = preparedBody(grandSympatheticKeys());
+  for (int k = 0; k < body.keys(); ++k) body.setDamper(k, 0.0);
+  double scale = 0;
+  const double r = balanceResidual(body, 12000, &scale);
+  std::printf("coupled balance residual %.3g of %.3g J\n", r, scale);
+  EXPECT_LT(r, 1e-12);
+  EXPECT_GT(body.strings().dissipated(), 0.0);
+}
+
+// Lossless board and strings: once the force stops, H_board + H_strings + H_c is constant.
+TEST(SympatheticStrings, LosslessCoupledSystemConservesEnergyExactly) {
+  PianoBodySpec spec;
+  spec.board.lossFactor = 0.0;
+  PianoBody body = preparedBody(lossless(grandSympatheticKeys()), spec);
+  for (int k = 0; k < body.keys(); ++k) body.setDamper(k, 0.0);
+  std::vector<double> f(body.keys(), 0.0);
+  f[39] = 40.0;
+  f[70] = -25.0;
+  body.step(f);
+  f.assign(body.keys(), 0.0);
+  const double h0 = body.energy();
+  double worst = 0.0;
+  for (int n = 0; n < 20000; ++n) {
+    body.step(f);
+    worst = std::max(worst, std::abs(body.energy() - h0));
+  }
+  std::printf("lossless drift %.3g of %.3g J\n", worst / h0, h0);
+  EXPECT_EQ(body.dissipated(), 0.0);
+  EXPECT_GT(h0, 0.0);
+  EXPECT_LT(worst, 1e-12 * h0);
+}
+
+// Excluding a key (a voice plays it) and bringing it back keeps the balance: the jump is booked.
+TEST(SympatheticStrings, ExclusionKeepsTheBalance) {
+  PianoBody body = preparedBody(grandSympatheticKeys());
+  for (int k = 0; k < body.keys(); ++k) body.setDamper(k, 0.0);
+  std::vector<double> f(body.keys(), 0.0);
+  double scale = 0.0, worst = 0.0;
+  for (int n = 0; n < 9000; ++n) {
+    f[39] = n < 3000 ? 20.0 * std::sin(2 * kPi * 261.6 * n / kRate) : 0.0;
+    if (n == 1500) body.setExcluded(39, true);
+    if (n == 1600) body.setExcluded(51, true);
+    if (n == 4000) body.setExcluded(39, false);
+    body.step(f);
+    const double h = body.energy();
+    scale = std::max({scale, std::abs(h), body.dissipated(), body.supplied()});
+    worst = std::max(worst, std::abs(h + body.dissipated() - body.supplied()));
+  }
+  EXPECT_TRUE(body.strings().excluded(51));
+  EXPECT_EQ(body.strings().keyEnergy(51), 0.0);
+  EXPECT_LT(worst, 1e-12 * scale);
+}
+
+struct CoupledMode {
+  double hz, sigma;
+};
+
+// The coupled first partial of key `key`: ring the board at the key's point, wait 0.5 s for the
+// board's modes to die away (σ = ηω/2 ≥ 2 s⁻¹), then count the partial's zero crossings and take
+// its decay from its peaks 0.5 s apart. The other keys' dampers are down, so the key's own
+// partial dominates its amplitude.
+CoupledMode coupledMode(PianoBody& body, int key) {
+  std::vector<double> f(body.keys(), 0.0);
+  f[key] = 100.0;
+  body.step(f);
+  f[key] = 0.0;
+  const int start = static_cast<int>(0.5 * kRate), end = static_cast<int>(1.0 * kRate);
+  std::vector<double> a(end);
+  for (int n = 0; n < end; ++n) {
+    body.step(f);
+    a[n] = body.strings().partialAmplitude(key, 1);
+  }
+  body.reset();
+  double first = -1, last = -1;
+  int crossings = 0;
+  for (int n = start; n + 1 < end; ++n)
+    if (a[n] <= 0 && a[n + 1] > 0) {
+      const double t = n + a[n] / (a[n] - a[n + 1]);
+      if (first < 0) first = t;
+      last = t;
+      ++crossings;
+    }
+  const double hz = (crossings - 1) / ((last - first) / kRate);
+  const int period = static_cast<int>(kRate / hz) + 2;
+  const auto peak = [&](int at) {
+    double v = 0;
+    for (int n = at; n < at + period; ++n) v = std::max(v, std::abs(a[n]));
+    return v;
+  };
+  const int t1 = start, t2 = end - period - 1;
+  return {hz, std::log(peak(t1) / peak(t2)) / ((t2 - t1) / kRate)};
+}
+
+// Mean string energy of `receiver` over the last 0.25 s of a 2.5 s sinusoid of `hz` at `driven`,
+// and (in `after`) its energy 0.25 s after the sinusoid stops.
+double drivenEnergy(PianoBody& body, int driven, int receiver, double hz, double* after) {
+  std::vector<double> f(body.keys(), 0.0);
+  const int steps = static_cast<int>(2.5 * kRate), tail = static_cast<int>(0.25 * kRate);
+  double sum = 0.0;
+  for (int n = 0; n < steps + tail; ++n) {
+    f[driven] = n < steps ? std::sin(2 * kPi * hz * n / kRate) : 0.0;
+    body.step(f);
+    if (n >= steps - tail && n < steps) sum += body.strings().keyEnergy(receiver);
+  }
+  *after = body.strings().keyEnergy(receiver);
+  body.reset();
+  return sum / tail;
+}
+
+// C4's bridge point forced at C5's coupled fundamental, the other dampers down. Driven at
+// resonance, the energy goes as 1/σ², σ the coupled mode's decay rate (its own loss plus what the
+// board takes, measured lifted; the damper adds its σ to it): lifted over damped is
+// (σ_damped/σ_lifted)², to 2 dB (2.5 s is several time constants of the lifted mode, the mean is
+// over 0.25 s). When the drive stops (C4 released),
+// the damped string dies in its 0.37 s while the lifted one rings on: ≥ 20 dB more 0.25 s later.
+// C#5, whose partials miss the frequency, answers ≥ 20 dB less than C5 beside it on the bridge.
+TEST(SympatheticStrings, StringsRingInSympathyWithDampersLifted) {
+  PianoBody body = preparedBody(grandSympatheticKeys());
+  const int c4 = 60 - kA0, c5 = 72 - kA0, cs5 = 73 - kA0;
+  for (int k = 0; k < body.keys(); ++k) body.setDamper(k, 1.0);
+  const double sigmaDamper = body.strings().partialDecayRate(c5, 1);
+  body.setDamper(c5, 0.0);
+  body.setDamper(cs5, 0.0);
+  const double sigmaOwn = body.strings().partialDecayRate(c5, 1);
+  const CoupledMode lifted = coupledMode(body, c5);
+  const double hz = lifted.hz;
+  EXPECT_NEAR(hz, body.strings().partialHz(c5, 1), 0.01 * hz);  // the board pulls it a little
+  double liftedAfter = 0, dampedAfter = 0, neighbourAfter = 0;
+  const double liftedEnergy = drivenEnergy(body, c4, c5, hz, &liftedAfter);
+  const double neighbour = drivenEnergy(body, c4, cs5, hz, &neighbourAfter);
+  body.setDamper(c5, 1.0);
+  const double dampedEnergy = drivenEnergy(body, c4, c5, hz, &dampedAfter);
+  const double drivenDb = 10 * std::log10(liftedEnergy / dampedEnergy);
+  // The board's share of the lifted decay, σ_lifted − σ_own, is the same with the damper on.
+  const double boardShare = lifted.sigma - sigmaOwn;
+  const double dampedSigma = sigmaDamper + boardShare;
+  const double expectedDb = 20 * std::log10(dampedSigma / lifted.sigma);
+  const double afterDb = 10 * std::log10(liftedAfter / dampedAfter);
+  const double neighbourDb = 10 * std::log10(liftedEnergy / neighbour);
+  std::printf(
+      "C5 coupled %.3f Hz (string %.3f), sigma lifted %.3f damped %.3f 1/s; driven: lifted/damped "
+      "%.1f dB (1/sigma^2: %.1f dB), 0.25 s after: %.1f dB; C5/C#5 %.1f dB\n",
+      hz, body.strings().partialHz(c5, 1), lifted.sigma, dampedSigma, drivenDb, expectedDb, afterDb,
+      neighbourDb);
+  EXPECT_NEAR(drivenDb, expectedDb, 2.0);
+  EXPECT_GE(afterDb, 20.0);
+  EXPECT_GE(neighbourDb, 20.0);
+}
+
+TEST(SympatheticStrings, StabilityConditionIsChecked) {
+  auto keys = grandSympatheticKeys();
+  keys[87].tension = 1e9;  // a string as stiff as a wall on the bridge
+  PianoBody body;
+  const PianoBodySpec spec;
+  try {
+    body.prepare(spec, bridgeLine(21, 108, spec.board), keys);
+    ADD_FAILURE() << "accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("must be < 2 for stability"));
+  }
+}
+
+TEST(SympatheticStrings, InvalidKeysAreRefusedByName) {
+  const PianoBodySpec spec;
+  const auto points = bridgeLine(21, 108, spec.board);
+  auto keys = grandSympatheticKeys();
+  keys[10].length = -1.0;
+  PianoBody body;
+  try {
+    body.prepare(spec, points, keys);
+    ADD_FAILURE();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("key 10 length = -1"));
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("> 0"));
+  }
+  keys = grandSympatheticKeys();
+  keys.pop_back();
+  EXPECT_THROW(body.prepare(spec, points, keys), std::invalid_argument);
+  PianoBodySpec high = spec;
+  high.sympatheticMaxHz = 13000.0;  // above fs/4
+  try {
+    body.prepare(high, points, grandSympatheticKeys());
+    ADD_FAILURE();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("maxHz = 13000: must be in (0, 12000)"));
+  }
+}
+
+}  // namespace
+}  // namespace hamiltone
