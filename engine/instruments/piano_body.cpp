@@ -29,8 +29,7 @@ void PianoBody::step(std::span<const double> bridgeForces) noexcept {
 #pragma omp simd reduction(+ : before)
   for (int k = 0; k < n; ++k) before += bridgeForces[k] * wPrev[k];
   forces_.setZero();
-  strings_.addBoardForces(w, {forces_.data(), static_cast<std::size_t>(n)});  // (Y4) at level n
-  strings_.step(w);                                                           // (Y3) with w^n
+  strings_.step(w, {forces_.data(), static_cast<std::size_t>(n)});  // (Y3), (Y4) with w^n
   board_.addForces({forces_.data(), static_cast<std::size_t>(n)});
   board_.addForces(bridgeForces);
   board_.step();

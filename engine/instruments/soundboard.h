@@ -6,6 +6,8 @@
 #include <span>
 #include <vector>
 
+#include "instruments/modal_projection.h"
+
 namespace hamiltone {
 
 // A point on the board, m: x along the grain (0 … lx), y across it, along the ribs (0 … ly).
@@ -76,9 +78,11 @@ class Soundboard {
   std::vector<std::pair<int, int>> index_;
   Eigen::VectorXd omega_, omegaHat2_, sigma_;
   Eigen::VectorXd c1_, c2_, c3_;  // a^{n+1} = c1 a^n − c2 a^{n−1} + c3 g   (S1 solved)
-  // Φ: points × modes, row-major (each point's modes contiguous): w = Φa, g = Φᵀ F.
-  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> phi_;
+  // Φ: points × modes, row-major (each point's modes contiguous), in float (modal_projection.h):
+  // w = Φa, g = Φᵀ F. phiColumns_ holds the same values, modes × points, in double.
+  Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> phi_;
   Eigen::MatrixXd phiColumns_;
+  const ModalProjection* projection_ = nullptr;
   Eigen::Matrix<double, 2, Eigen::Dynamic, Eigen::RowMajor> pickupShapes_;
   Eigen::VectorXd a_, aPrev_, g_, force_, w_, wPrev_;
   double dissipated_ = 0.0, supplied_ = 0.0;

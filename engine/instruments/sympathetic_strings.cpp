@@ -74,9 +74,30 @@ void SympatheticStrings::prepare(std::span<const SympatheticKey> keys, const Sou
   data_.assign(keys.begin(), keys.end());
   k_ = 1.0 / sampleRate;
   const int keyCount = static_cast<int>(keys.size());
-  first_.assign(keyCount + 1, 0);
-  std::vector<double> mass, stiffness, omega, sigma, coupling;
-  std::vector<int> owner;
+  keys_ = keyCount;
+  partials_.assign(keyCount, 0);
+  for (int key = 0; key < keyCount; ++key) {
+    const SympatheticKey& s = keys[key];
+    while (partials_[key] < maxPartials) {
+      const int n = partials_[key] + 1;
+      if (n * s.f0 * std::sqrt(1.0 + s.inharmonicityB * n * n) > maxHz) break;
+      ++partials_[key];
+    }
+  }
+  rows_ = keyCount ? *std::max_element(partials_.begin(), partials_.end()) : 0;
+  // Row n − 1 runs over the keys up to the last with n partials: the higher the key, the fewer
+  // partials below maxHz, so a row is nearly all in use.
+  rowLength_.assign(rows_, 0);
+  for (int key = 0; key < keyCount; ++key)
+    for (int row = 0; row < partials_[key]; ++row) rowLength_[row] = key + 1;
+  // Slot j = (n − 1) keys + key: partial n of every key side by side, so the loops run across the
+  // keys with w_key and F_key contiguous. Missing partials are zeros that stay zero.
+  const Eigen::Index total = static_cast<Eigen::Index>(rows_) * keyCount;
+  mass_.setOnes(total);
+  stiffness_.setZero(total);
+  omega_.setZero(total);
+  sigmaOwn_.setZero(total);
+  cOn_.setZero(total);
   kappaOn_.resize(keyCount);
   for (int key = 0; key < keyCount; ++key) {
     const SympatheticKey& s = keys[key];
@@ -85,9 +106,9 @@ void SympatheticStrings::prepare(std::span<const SympatheticKey> keys, const Sou
     const double sigma1 =
         std::max(0.0, (kLn1000 / s.t60High - sigma0) / wavenumber2(s, 2.0 * kPi * s.t60HighHz));
     double kappa = u * s.tension / s.length;  // (Y2): the static T/L per string
-    for (int n = 1; n <= maxPartials; ++n) {
+    for (int n = 1; n <= partials_[key]; ++n) {
+      const Eigen::Index j = slot(key, n);
       const double fn = n * s.f0 * std::sqrt(1.0 + s.inharmonicityB * n * n);
-      if (fn > maxHz) break;
       const double nu = n * kPi / s.length;
       const double m = u * s.linearDensity * s.length / 2.0;  // (Y1)
       const double sn = std::sin(kPi * fn * k_);              // sin(ωk/2)
@@ -95,14 +116,12 @@ void SympatheticStrings::prepare(std::span<const SympatheticKey> keys, const Sou
       const double c =
           u * ((n % 2) ? -1.0 : 1.0) * nu * s.tension * (1.0 + s.inharmonicityB * n * n);
       kappa += c * c / kHat;  // (Y2)
-      mass.push_back(m);
-      stiffness.push_back(kHat);
-      omega.push_back(2.0 * kPi * fn);
-      sigma.push_back(sigma0 + sigma1 * nu * nu);  // σ0 + σ1 ξ_n, ξ_n = (nπ/L)²
-      coupling.push_back(c);
-      owner.push_back(key);
+      mass_[j] = m;
+      stiffness_[j] = kHat;
+      omega_[j] = 2.0 * kPi * fn;
+      sigmaOwn_[j] = sigma0 + sigma1 * nu * nu;  // σ0 + σ1 ξ_n, ξ_n = (nπ/L)²
+      cOn_[j] = c;
     }
-    first_[key + 1] = static_cast<int>(mass.size());
     kappaOn_[key] = kappa;
   }
 
@@ -120,22 +139,13 @@ void SympatheticStrings::prepare(std::span<const SympatheticKey> keys, const Sou
         " N/m) makes k^2 lambda_max = " + formatApprox(lambda * k_ * k_) +
         ": must be < 2 for stability (fewer partials, a lower maxHz or a higher sample rate)");
 
-  const auto vec = [](const std::vector<double>& v) {
-    return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
-  };
-  mass_ = vec(mass);
-  stiffness_ = vec(stiffness);
-  omega_ = vec(omega);
-  sigmaOwn_ = vec(sigma);
-  cOn_ = vec(coupling);
-  key_ = owner;
-  const Eigen::Index total = mass_.size();
-  sigma_.resize(total);
+  sigma_.setZero(total);
   c_ = cOn_;
   kappa_ = kappaOn_;
-  a1_.resize(total);
-  a2_.resize(total);
-  a3_.resize(total);
+  lost_.setZero(total);
+  a1_.setZero(total);
+  a2_.setZero(total);
+  a3_.setZero(total);
   b_.resize(total);
   bPrev_.resize(total);
   contact_.assign(keyCount, 0.0);
@@ -147,14 +157,15 @@ void SympatheticStrings::prepare(std::span<const SympatheticKey> keys, const Sou
 void SympatheticStrings::reset() noexcept {
   b_.setZero();
   bPrev_.setZero();
-  dissipated_ = 0.0;
+  lost_.setZero();
 }
 
 void SympatheticStrings::setCoefficients(int key) noexcept {
   const SympatheticKey& s = data_[key];
   const double c = contact_[key];
   const double damper = std::isinf(s.damperT60) ? 0.0 : kLn1000 / s.damperT60;
-  for (int j = first_[key]; j < first_[key + 1]; ++j) {
+  for (int n = 1; n <= partials_[key]; ++n) {
+    const Eigen::Index j = slot(key, n);
     // The damper blends the decay rate: (1 − c) σ_own + c σ_damper (T60 = damperT60 at c = 1).
     const double sigma =
         std::isinf(s.damperT60) ? sigmaOwn_[j] : (1.0 - c) * sigmaOwn_[j] + c * damper;
@@ -173,7 +184,8 @@ void SympatheticStrings::setDamper(int key, double contact) noexcept {
 
 double SympatheticStrings::keyEnergy(int key) const noexcept {
   double h = 0.0;
-  for (int j = first_[key]; j < first_[key + 1]; ++j) {
+  for (int n = 1; n <= partials_[key]; ++n) {
+    const Eigen::Index j = slot(key, n);
     const double d = (b_[j] - bPrev_[j]) / k_;
     h += 0.5 * (mass_[j] * d * d + stiffness_[j] * b_[j] * bPrev_[j]);
   }
@@ -183,8 +195,10 @@ double SympatheticStrings::keyEnergy(int key) const noexcept {
 // Key k's share of (Y5), w = w^{n+1}, wPrev = w^n.
 double SympatheticStrings::keyCoupling(int key, double w, double wPrev) const noexcept {
   double h = 0.5 * kappa_[key] * w * wPrev;
-  for (int j = first_[key]; j < first_[key + 1]; ++j)
+  for (int n = 1; n <= partials_[key]; ++n) {
+    const Eigen::Index j = slot(key, n);
     h += 0.5 * c_[j] * (b_[j] * wPrev + bPrev_[j] * w);
+  }
   return h;
 }
 
@@ -194,7 +208,8 @@ double SympatheticStrings::setExcluded(int key, bool excluded, const Eigen::Vect
   const double before = keyEnergy(key) + keyCoupling(key, w[key], wPrev[key]);
   excluded_[key] = excluded;
   kappa_[key] = excluded ? 0.0 : kappaOn_[key];
-  for (int j = first_[key]; j < first_[key + 1]; ++j) {
+  for (int n = 1; n <= partials_[key]; ++n) {
+    const Eigen::Index j = slot(key, n);
     c_[j] = excluded ? 0.0 : cOn_[j];
     // Back at rest on the board: the static shape u = w x/L, a_n = −C_n w/K̂_n.
     b_[j] = excluded ? 0.0 : -c_[j] * w[key] / stiffness_[j];
@@ -203,44 +218,38 @@ double SympatheticStrings::setExcluded(int key, bool excluded, const Eigen::Vect
   return keyEnergy(key) + keyCoupling(key, w[key], wPrev[key]) - before;
 }
 
-void SympatheticStrings::addBoardForces(const Eigen::VectorXd& w,
-                                        std::span<double> forces) const noexcept {
-  const int keyCount = keys();
-  const double* b = b_.data();
-  const double* c = c_.data();
-  for (int key = 0; key < keyCount; ++key) {
-    double f = -kappa_[key] * w[key];  // (Y4)
-    const int end = first_[key + 1];
-#pragma omp simd reduction(- : f)
-    for (int j = first_[key]; j < end; ++j) f -= c[j] * b[j];
-    forces[key] += f;
-  }
-}
-
-void SympatheticStrings::step(const Eigen::VectorXd& w) noexcept {
-  const int keyCount = keys();
-  const double* a1 = a1_.data();
-  const double* a2 = a2_.data();
-  const double* a3 = a3_.data();
-  const double* c = c_.data();
-  const double* sigma = sigma_.data();
-  const double* mass = mass_.data();
-  const double* b = b_.data();
-  double* prev = bPrev_.data();  // a^{n−1} in, a^{n+1} out
-  double lost = 0.0;
-  for (int key = 0; key < keyCount; ++key) {
-    const double wk = w[key];
-    const int end = first_[key + 1];
-#pragma omp simd reduction(+ : lost)
-    for (int j = first_[key]; j < end; ++j) {
-      const double next = a1[j] * b[j] - a2[j] * prev[j] - a3[j] * c[j] * wk;  // (Y3)
-      const double d = next - prev[j];
-      lost += mass[j] * sigma[j] * d * d;
-      prev[j] = next;
+void SympatheticStrings::step(const Eigen::VectorXd& w, std::span<double> forces) noexcept {
+  const long keyCount = keys_;
+  const double* wk = w.data();
+  double* f = forces.data();
+  const double* kappa = kappa_.data();
+#pragma omp simd
+  for (long key = 0; key < keyCount; ++key) f[key] -= kappa[key] * wk[key];  // (Y4): −κ w^n
+  for (int row = 0; row < rows_; ++row) {
+    const long at = row * keyCount, length = rowLength_[row];
+    const double* a1 = a1_.data() + at;
+    const double* a2 = a2_.data() + at;
+    const double* a3 = a3_.data() + at;
+    const double* c = c_.data() + at;
+    const double* sigma = sigma_.data() + at;
+    const double* b = b_.data() + at;
+    double* prev = bPrev_.data() + at;  // a^{n−1} in, a^{n+1} out
+    double* lost = lost_.data() + at;   // per slot: no chain of sums through the loop
+#pragma omp simd
+    for (long key = 0; key < length; ++key) {
+      f[key] -= c[key] * b[key];  // (Y4): −Σ_n C_n a_n^n
+      const double next =
+          a1[key] * b[key] - a2[key] * prev[key] - a3[key] * c[key] * wk[key];  // (Y3)
+      const double d = next - prev[key];
+      lost[key] += sigma[key] * d * d;  // over M/2k: k 2Mσ (δt· a)²
+      prev[key] = next;
     }
   }
-  dissipated_ += lost / (2.0 * k_);  // k 2Mσ (δt· a)²
   b_.swap(bPrev_);
+}
+
+double SympatheticStrings::dissipated() const noexcept {
+  return mass_.cwiseProduct(lost_).sum() / (2.0 * k_);
 }
 
 double SympatheticStrings::energy(const Eigen::VectorXd& w,
@@ -251,7 +260,7 @@ double SympatheticStrings::energy(const Eigen::VectorXd& w,
 }
 
 double SympatheticStrings::partialHz(int key, int n) const noexcept {
-  return omega_[first_[key] + n - 1] / (2.0 * kPi);
+  return omega_[slot(key, n)] / (2.0 * kPi);
 }
 
 }  // namespace hamiltone

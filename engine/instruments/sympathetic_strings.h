@@ -67,37 +67,41 @@ class SympatheticStrings {
                      const Eigen::VectorXd& wPrev) noexcept;
   bool excluded(int key) const noexcept { return excluded_[key] != 0; }
 
-  // (Y4): adds the strings' forces at level n on the board's points, N.
-  void addBoardForces(const Eigen::VectorXd& w, std::span<double> forces) const noexcept;
-  void step(const Eigen::VectorXd& w) noexcept;  // (Y3): level n → n+1, w = w^n
+  // (Y3): level n → n+1 given w = w^n; adds the strings' forces (Y4) at level n on the board's
+  // points to `forces`, N (one pass over the partials for both).
+  void step(const Eigen::VectorXd& w, std::span<double> forces) noexcept;
 
   // H_strings + H_c at n+½ given w^{n+1} (w) and w^n (wPrev), J.
   double energy(const Eigen::VectorXd& w, const Eigen::VectorXd& wPrev) const noexcept;
-  double dissipated() const noexcept { return dissipated_; }
+  double dissipated() const noexcept;  // J; a sum over the partials, not for every sample
   // One key's string energy Σ M/2 (δt₋ a)² + K̂/2 a^n a^{n−1}, J (no coupling term).
   double keyEnergy(int key) const noexcept;
 
-  int keys() const noexcept { return static_cast<int>(first_.size()) - 1; }
-  int partials(int key) const noexcept { return first_[key + 1] - first_[key]; }
+  int keys() const noexcept { return keys_; }
+  int partials(int key) const noexcept { return partials_[key]; }
   double partialHz(int key, int n) const noexcept;                        // n = 1 … partials(key)
   double bridgeStiffness(int key) const noexcept { return kappa_[key]; }  // κ_k, N/m
-  double partialDecayRate(int key, int n) const noexcept { return sigma_[first_[key] + n - 1]; }
-  double partialAmplitude(int key, int n) const noexcept { return b_[first_[key] + n - 1]; }
+  double partialDecayRate(int key, int n) const noexcept { return sigma_[slot(key, n)]; }
+  double partialAmplitude(int key, int n) const noexcept { return b_[slot(key, n)]; }
 
  private:
+  Eigen::Index slot(int key, int n) const noexcept {
+    return static_cast<Eigen::Index>(n - 1) * keys_ + key;
+  }
   void setCoefficients(int key) noexcept;
   double keyCoupling(int key, double w, double wPrev) const noexcept;
   std::vector<SympatheticKey> data_;
   double k_ = 0.0;
-  std::vector<int> first_;  // key k's partials are first_[k] … first_[k+1) − 1
+  int keys_ = 0, rows_ = 0;  // rows_: the most partials of any key
+  std::vector<int> partials_, rowLength_;
   std::vector<double> contact_;
   std::vector<char> excluded_;
   Eigen::VectorXd kappa_, kappaOn_;  // κ_k in use (0 when excluded) and as prepared
-  // Per partial: mass, K̂, ω, own σ, σ in use, coupling in use and as prepared, step coefficients.
+  // Per partial slot (n − 1) keys + key: mass, K̂, ω, own σ, σ in use, coupling in use and as
+  // prepared, step coefficients.
   Eigen::VectorXd mass_, stiffness_, omega_, sigmaOwn_, sigma_, c_, cOn_, a1_, a2_, a3_;
-  std::vector<int> key_;
   Eigen::VectorXd b_, bPrev_;
-  double dissipated_ = 0.0;
+  Eigen::VectorXd lost_;  // per slot, Σ σ (a^{n+1} − a^{n−1})²: times M/2k, what the loss took
 };
 
 }  // namespace hamiltone

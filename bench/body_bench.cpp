@@ -1,0 +1,81 @@
+// Cost of the piano's body at 48 kHz: the modal soundboard alone and with the 88 keys'
+// sympathetic strings (PianoBody), every bridge point driven, against the highest board mode.
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <span>
+#include <vector>
+
+#include "instruments/piano_body.h"
+
+namespace hamiltone {
+namespace {
+
+constexpr double kSampleRate = 48000.0;
+const BoardPoint kPickups[2] = {{0.45, 0.35}, {1.2, 0.9}};
+
+// "cpu/audio_s" is the CPU time per second of audio: 0.05 (shown "50ms") is 5 % of one core.
+benchmark::Counter perAudioSecond(double steps) {
+  return benchmark::Counter(steps / kSampleRate,
+                            benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+// A force on every point, different each step, as 88 sounding keys would give: 256 steps of them
+// made beforehand, so that the sines are not timed.
+class Forces {
+ public:
+  Forces() : f_(256 * 88) {
+    for (int n = 0; n < 256; ++n)
+      for (int k = 0; k < 88; ++k) f_[n * 88 + k] = std::sin(0.05 * n * (k + 1));
+  }
+  std::span<const double> at(long n) const { return {f_.data() + (n & 255) * 88, 88}; }
+
+ private:
+  std::vector<double> f_;
+};
+
+void boardStep(benchmark::State& state) {
+  SoundboardPhysics p;
+  p.maxModeHz = static_cast<double>(state.range(0));
+  Soundboard board;
+  board.prepare(p, kSampleRate, bridgeLine(21, 108, p), kPickups);
+  const Forces forces;
+  long n = 0;
+  for (auto _ : state) {
+    board.addForces(forces.at(n++));
+    board.step();
+    double l, r;
+    board.pickups(l, r);
+    benchmark::DoNotOptimize(l + r);
+  }
+  state.counters["modes"] = board.modes();
+  state.counters["cpu/audio_s"] = perAudioSecond(static_cast<double>(state.iterations()));
+}
+BENCHMARK(boardStep)->ArgName("maxModeHz")->Arg(1000)->Arg(1500)->Arg(2000)->Arg(3000)->Arg(4000);
+
+void bodyStep(benchmark::State& state) {
+  PianoBodySpec spec;
+  spec.board.maxModeHz = static_cast<double>(state.range(0));
+  PianoBody body;
+  body.prepare(spec, bridgeLine(21, 108, spec.board), grandSympatheticKeys());
+  for (int k = 0; k < body.keys(); ++k) body.setDamper(k, 0.0);  // the sustain pedal down
+  const Forces forces;
+  long n = 0;
+  for (auto _ : state) {
+    body.step(forces.at(n++));
+    double l, r;
+    body.output(l, r);
+    benchmark::DoNotOptimize(l + r);
+  }
+  int partials = 0;
+  for (int k = 0; k < body.keys(); ++k) partials += body.strings().partials(k);
+  state.counters["modes"] = body.board().modes();
+  state.counters["partials"] = partials;
+  state.counters["cpu/audio_s"] = perAudioSecond(static_cast<double>(state.iterations()));
+}
+BENCHMARK(bodyStep)->ArgName("maxModeHz")->Arg(1500)->Arg(2000)->Arg(3000);
+
+}  // namespace
+}  // namespace hamiltone
+
+BENCHMARK_MAIN();

@@ -1,0 +1,56 @@
+// The loops of modal_projection.cpp, included once per instruction set with HAMILTONE_TARGET (a
+// function attribute) and HAMILTONE_PROJECTION_NS (its namespace) defined. Four points at a time:
+// a's values are loaded once for four rows, g is read and written once for four points.
+namespace HAMILTONE_PROJECTION_NS {
+
+HAMILTONE_TARGET void gather(const float* phi, long ld, long points, long modes, const double* a,
+                             double* w) {
+  long k = 0;
+  for (; k + 4 <= points; k += 4) {
+    const float *r0 = phi + k * ld, *r1 = r0 + ld, *r2 = r1 + ld, *r3 = r2 + ld;
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
+#pragma omp simd reduction(+ : s0, s1, s2, s3)
+    for (long m = 0; m < modes; ++m) {
+      s0 += static_cast<double>(r0[m]) * a[m];
+      s1 += static_cast<double>(r1[m]) * a[m];
+      s2 += static_cast<double>(r2[m]) * a[m];
+      s3 += static_cast<double>(r3[m]) * a[m];
+    }
+    w[k] = s0;
+    w[k + 1] = s1;
+    w[k + 2] = s2;
+    w[k + 3] = s3;
+  }
+  for (; k < points; ++k) {
+    const float* row = phi + k * ld;
+    double s = 0.0;
+#pragma omp simd reduction(+ : s)
+    for (long m = 0; m < modes; ++m) s += static_cast<double>(row[m]) * a[m];
+    w[k] = s;
+  }
+}
+
+HAMILTONE_TARGET void project(const float* phi, long ld, long points, long modes, const double* f,
+                              double* g) {
+  for (long m = 0; m < modes; ++m) g[m] = 0.0;
+  long k = 0;
+  for (; k + 4 <= points; k += 4) {
+    const double f0 = f[k], f1 = f[k + 1], f2 = f[k + 2], f3 = f[k + 3];
+    if (f0 == 0.0 && f1 == 0.0 && f2 == 0.0 && f3 == 0.0) continue;  // points not in use
+    const float *r0 = phi + k * ld, *r1 = r0 + ld, *r2 = r1 + ld, *r3 = r2 + ld;
+#pragma omp simd
+    for (long m = 0; m < modes; ++m)
+      g[m] += ((static_cast<double>(r0[m]) * f0 + static_cast<double>(r1[m]) * f1) +
+               static_cast<double>(r2[m]) * f2) +
+              static_cast<double>(r3[m]) * f3;
+  }
+  for (; k < points; ++k) {
+    const double fk = f[k];
+    if (fk == 0.0) continue;
+    const float* row = phi + k * ld;
+#pragma omp simd
+    for (long m = 0; m < modes; ++m) g[m] += static_cast<double>(row[m]) * fk;
+  }
+}
+
+}  // namespace HAMILTONE_PROJECTION_NS
