@@ -20,7 +20,7 @@ struct BoardPoint {
 struct SoundboardPhysics {
   double lx = 1.9, ly = 1.3;  // m: 2.47 m² (§5.1)
   double thickness = 9e-3;    // h, m (§5.1)
-  double density = 583.0;     // ρ, kg/m³: spruce 380 plus the ribs' mass smeared over h (§5.2)
+  double density = 664.2;     // ρ, kg/m³: spruce 380 plus the ribs' mass smeared over h (§5.2)
   double d1 = 671.0;          // D1, N·m: along the grain, E1 h³/12(1 − ν12ν21) (§5.2)
   double d2 = 10220.0;        // D2, N·m: across the grain, the ribs' EI per spacing (§5.2)
   double d3 = 90.5;           // D3 = D12 + 2 D66, N·m (§5.2)
