@@ -2,6 +2,7 @@
 // sympathetic strings (PianoBody), every bridge point driven, against the highest board mode.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <cmath>
 #include <span>
 #include <vector>
@@ -51,11 +52,24 @@ void boardStep(benchmark::State& state) {
   state.counters["modes"] = board.modes();
   state.counters["cpu/audio_s"] = perAudioSecond(static_cast<double>(state.iterations()));
 }
-BENCHMARK(boardStep)->ArgName("maxModeHz")->Arg(1000)->Arg(1500)->Arg(2000)->Arg(3000)->Arg(4000);
+// On a shared machine the least-disturbed repetition is the one to read:
+// --benchmark_repetitions=10 --benchmark_report_aggregates_only=true reports it as "_min".
+double fastest(const std::vector<double>& v) { return *std::min_element(v.begin(), v.end()); }
+
+BENCHMARK(boardStep)
+    ->ArgName("maxModeHz")
+    ->Arg(800)
+    ->Arg(1000)
+    ->Arg(1500)
+    ->Arg(2000)
+    ->Arg(3000)
+    ->Arg(4000)
+    ->ComputeStatistics("min", fastest);
 
 void bodyStep(benchmark::State& state) {
   PianoBodySpec spec;
   spec.board.maxModeHz = static_cast<double>(state.range(0));
+  spec.sympatheticMaxPartials = static_cast<int>(state.range(1));
   PianoBody body;
   body.prepare(spec, bridgeLine(21, 108, spec.board), grandSympatheticKeys());
   for (int k = 0; k < body.keys(); ++k) body.setDamper(k, 0.0);  // the sustain pedal down
@@ -73,7 +87,10 @@ void bodyStep(benchmark::State& state) {
   state.counters["partials"] = partials;
   state.counters["cpu/audio_s"] = perAudioSecond(static_cast<double>(state.iterations()));
 }
-BENCHMARK(bodyStep)->ArgName("maxModeHz")->Arg(1500)->Arg(2000)->Arg(3000);
+BENCHMARK(bodyStep)
+    ->ArgNames({"maxModeHz", "partials"})
+    ->ArgsProduct({{800, 1000, 1500, 2000, 3000}, {8, 16}})
+    ->ComputeStatistics("min", fastest);
 
 }  // namespace
 }  // namespace hamiltone

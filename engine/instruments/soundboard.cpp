@@ -107,7 +107,7 @@ void Soundboard::prepare(const SoundboardPhysics& p, double sampleRate,
   for (int k = 0; k < pointCount; ++k)
     for (int i = 0; i < modeCount; ++i) phi_(k, i) = static_cast<float>(shape(i, bridgePoints[k]));
   phiColumns_ = phi_.transpose().cast<double>();
-  projection_ = &selectedModalProjection();
+  loops_ = &selectedBodyLoops();
   pickupShapes_.resize(2, modeCount);
   for (int j = 0; j < 2; ++j)
     for (int i = 0; i < modeCount; ++i) pickupShapes_(j, i) = shape(i, pickupPoints[j]);
@@ -146,7 +146,7 @@ void Soundboard::addForces(std::span<const double> forces) noexcept {
 
 void Soundboard::step() noexcept {
   const long n = a_.size(), points = phi_.rows();
-  projection_->project(phi_.data(), n, points, n, force_.data(), g_.data());  // g_m = Σ_k φ_m F_k
+  loops_->project(phi_.data(), n, points, n, force_.data(), g_.data());  // g_m = Σ_k φ_m F_k
   const double* c1 = c1_.data();
   const double* c2 = c2_.data();
   const double* c3 = c3_.data();
@@ -167,7 +167,7 @@ void Soundboard::step() noexcept {
   supplied_ += 0.5 * work;  // Σ_k F_k (w^{n+1} − w^{n−1})/2 = Σ_m g_m (a^{n+1} − a^{n−1})/2
   a_.swap(aPrev_);
   wPrev_.swap(w_);
-  projection_->gather(phi_.data(), n, points, n, a_.data(), w_.data());  // w = Φ a^{n+1}
+  loops_->gather(phi_.data(), n, points, n, a_.data(), w_.data());  // w = Φ a^{n+1}
   force_.setZero();
 }
 

@@ -6,7 +6,7 @@
 #include <span>
 #include <vector>
 
-#include "instruments/modal_projection.h"
+#include "instruments/body_loops.h"
 
 namespace hamiltone {
 
@@ -25,7 +25,7 @@ struct SoundboardPhysics {
   double d2 = 10220.0;        // D2, N·m: across the grain, the ribs' EI per spacing (§5.2)
   double d3 = 90.5;           // D3 = D12 + 2 D66, N·m (§5.2)
   double lossFactor = 0.02;   // η: σ_m = η ω_m / 2 (§5.3)
-  double maxModeHz = 2000.0;  // every mode up to here (§5.4: the cost)
+  double maxModeHz = 1000.0;  // every mode up to here (§5.4: the cost with 88 points)
   double surfaceDensity() const { return density * thickness; }  // ρh, kg/m²
 };
 
@@ -78,11 +78,11 @@ class Soundboard {
   std::vector<std::pair<int, int>> index_;
   Eigen::VectorXd omega_, omegaHat2_, sigma_;
   Eigen::VectorXd c1_, c2_, c3_;  // a^{n+1} = c1 a^n − c2 a^{n−1} + c3 g   (S1 solved)
-  // Φ: points × modes, row-major (each point's modes contiguous), in float (modal_projection.h):
+  // Φ: points × modes, row-major (each point's modes contiguous), in float (body_loops.h):
   // w = Φa, g = Φᵀ F. phiColumns_ holds the same values, modes × points, in double.
   Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> phi_;
   Eigen::MatrixXd phiColumns_;
-  const ModalProjection* projection_ = nullptr;
+  const BodyLoops* loops_ = nullptr;
   Eigen::Matrix<double, 2, Eigen::Dynamic, Eigen::RowMajor> pickupShapes_;
   Eigen::VectorXd a_, aPrev_, g_, force_, w_, wPrev_;
   double dissipated_ = 0.0, supplied_ = 0.0;

@@ -7,6 +7,7 @@
 #include <span>
 #include <vector>
 
+#include "instruments/body_loops.h"
 #include "instruments/soundboard.h"
 
 namespace hamiltone {
@@ -94,6 +95,7 @@ class SympatheticStrings {
   double k_ = 0.0;
   int keys_ = 0, rows_ = 0;  // rows_: the most partials of any key
   std::vector<int> partials_, rowLength_;
+  const BodyLoops* loops_ = nullptr;
   std::vector<double> contact_;
   std::vector<char> excluded_;
   Eigen::VectorXd kappa_, kappaOn_;  // κ_k in use (0 when excluded) and as prepared

@@ -1,7 +1,7 @@
-// The loops of modal_projection.cpp, included once per instruction set with HAMILTONE_TARGET (a
-// function attribute) and HAMILTONE_PROJECTION_NS (its namespace) defined. Four points at a time:
-// a's values are loaded once for four rows, g is read and written once for four points.
-namespace HAMILTONE_PROJECTION_NS {
+// The loops of body_loops.cpp, included once per instruction set with HAMILTONE_TARGET (a
+// function attribute) and HAMILTONE_BODY_NS (its namespace) defined. The products take four
+// points at a time: a's values are loaded once for four rows, g read and written once for four.
+namespace HAMILTONE_BODY_NS {
 
 HAMILTONE_TARGET void gather(const float* phi, long ld, long points, long modes, const double* a,
                              double* w) {
@@ -53,4 +53,17 @@ HAMILTONE_TARGET void project(const float* phi, long ld, long points, long modes
   }
 }
 
-}  // namespace HAMILTONE_PROJECTION_NS
+HAMILTONE_TARGET void partialsRow(long keys, const double* a1, const double* a2, const double* a3,
+                                  const double* c, const double* sigma, const double* b,
+                                  const double* w, double* prev, double* lost, double* f) {
+#pragma omp simd
+  for (long key = 0; key < keys; ++key) {
+    f[key] -= c[key] * b[key];                                                               // (Y4)
+    const double next = a1[key] * b[key] - a2[key] * prev[key] - a3[key] * c[key] * w[key];  // (Y3)
+    const double d = next - prev[key];
+    lost[key] += sigma[key] * d * d;
+    prev[key] = next;
+  }
+}
+
+}  // namespace HAMILTONE_BODY_NS
