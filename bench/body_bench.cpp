@@ -92,6 +92,43 @@ BENCHMARK(bodyStep)
     ->ArgsProduct({{800, 1000, 1500, 2000, 3000}, {8, 16}})
     ->ComputeStatistics("min", fastest);
 
+// The sustain pedal up: dampers down, ten keys played by voices (their strings excluded, their
+// points driven), the damped keys asleep below a quiet floor of floor_per_mille thousandths of the
+// body's energy: at most the ten and the 20 keys without dampers (F6 … C8) stay in use; "points"
+// says how many do.
+void bodyStepPedalUp(benchmark::State& state) {
+  PianoBodySpec spec;
+  spec.board.maxModeHz = static_cast<double>(state.range(0));
+  PianoBody body;
+  body.prepare(spec, bridgeLine(21, 108, spec.board), grandSympatheticKeys());
+  const int played[] = {15, 27, 31, 34, 39, 43, 46, 51, 55, 58};
+  for (int k = 0; k < body.keys(); ++k) body.setDamper(k, 1.0);
+  for (int k : played) body.setExcluded(k, true);
+  body.setQuietFloor(1e-12, static_cast<double>(state.range(1)) * 1e-3);
+  std::vector<double> f(88, 0.0);
+  const Forces forces;
+  const auto drive = [&](long n) {
+    const auto all = forces.at(n);
+    for (int k : played) f[k] = all[k];
+    body.step(f);
+  };
+  long n = 0;
+  for (; n < 1024; ++n) drive(n);  // past the first look for quiet keys
+  for (auto _ : state) {
+    drive(n++);
+    double l, r;
+    body.output(l, r);
+    benchmark::DoNotOptimize(l + r);
+  }
+  state.counters["modes"] = body.board().modes();
+  state.counters["points"] = body.pointsInUse();
+  state.counters["cpu/audio_s"] = perAudioSecond(static_cast<double>(state.iterations()));
+}
+BENCHMARK(bodyStepPedalUp)
+    ->ArgNames({"maxModeHz", "floor_per_mille"})
+    ->ArgsProduct({{1000, 2000, 4000}, {1, 30}})
+    ->ComputeStatistics("min", fastest);
+
 }  // namespace
 }  // namespace hamiltone
 

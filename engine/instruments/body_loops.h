@@ -7,8 +7,9 @@
 namespace hamiltone {
 
 struct BodyLoops {
-  // w_k = Σ_m φ[k ld + m] a_m for k < points.
-  void (*gather)(const float* phi, long ld, long points, long modes, const double* a, double* w);
+  // w_k = Σ_m φ[k ld + m] a_m for the `count` points k = rows[0 … count).
+  void (*gather)(const float* phi, long ld, const int* rows, long count, long modes,
+                 const double* a, double* w);
   // g_m = Σ_k φ[k ld + m] f_k for m < modes; points with f_k = 0 are skipped (not in use).
   void (*project)(const float* phi, long ld, long points, long modes, const double* f, double* g);
   // Partial n of keys 0 … keys − 1 (sympathetic_strings.h (Y3), (Y4)): f −= c b; next = a1 b −

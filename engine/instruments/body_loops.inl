@@ -3,11 +3,12 @@
 // points at a time: a's values are loaded once for four rows, g read and written once for four.
 namespace HAMILTONE_BODY_NS {
 
-HAMILTONE_TARGET void gather(const float* phi, long ld, long points, long modes, const double* a,
-                             double* w) {
-  long k = 0;
-  for (; k + 4 <= points; k += 4) {
-    const float *r0 = phi + k * ld, *r1 = r0 + ld, *r2 = r1 + ld, *r3 = r2 + ld;
+HAMILTONE_TARGET void gather(const float* phi, long ld, const int* rows, long count, long modes,
+                             const double* a, double* w) {
+  long i = 0;
+  for (; i + 4 <= count; i += 4) {
+    const float *r0 = phi + rows[i] * ld, *r1 = phi + rows[i + 1] * ld,
+                *r2 = phi + rows[i + 2] * ld, *r3 = phi + rows[i + 3] * ld;
     double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
 #pragma omp simd reduction(+ : s0, s1, s2, s3)
     for (long m = 0; m < modes; ++m) {
@@ -16,17 +17,17 @@ HAMILTONE_TARGET void gather(const float* phi, long ld, long points, long modes,
       s2 += static_cast<double>(r2[m]) * a[m];
       s3 += static_cast<double>(r3[m]) * a[m];
     }
-    w[k] = s0;
-    w[k + 1] = s1;
-    w[k + 2] = s2;
-    w[k + 3] = s3;
+    w[rows[i]] = s0;
+    w[rows[i + 1]] = s1;
+    w[rows[i + 2]] = s2;
+    w[rows[i + 3]] = s3;
   }
-  for (; k < points; ++k) {
-    const float* row = phi + k * ld;
+  for (; i < count; ++i) {
+    const float* row = phi + rows[i] * ld;
     double s = 0.0;
 #pragma omp simd reduction(+ : s)
     for (long m = 0; m < modes; ++m) s += static_cast<double>(row[m]) * a[m];
-    w[k] = s;
+    w[rows[i]] = s;
   }
 }
 

@@ -1,10 +1,15 @@
 // The piano's body: one step of the soundboard and the sympathetic strings together.
 #include "instruments/piano_body.h"
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 
 namespace hamiltone {
+
+namespace {
+constexpr int kCheckEvery = 256;  // steps between looks for quiet damped keys
+}  // namespace
 
 void PianoBody::prepare(const PianoBodySpec& spec, std::span<const BoardPoint> bridgePoints,
                         std::span<const SympatheticKey> keys) {
@@ -12,13 +17,16 @@ void PianoBody::prepare(const PianoBodySpec& spec, std::span<const BoardPoint> b
   strings_.prepare(keys, board_, spec.sampleRate, spec.sympatheticMaxHz,
                    spec.sympatheticMaxPartials);
   forces_.setZero(board_.points());
+  active_.reserve(board_.points());
   reset();
 }
 
 void PianoBody::reset() noexcept {
   board_.reset();
   strings_.reset();
+  updateActivePoints();
   supplied_ = switched_ = 0.0;
+  sinceCheck_ = 0;
 }
 
 void PianoBody::step(std::span<const double> bridgeForces) noexcept {
@@ -38,11 +46,45 @@ void PianoBody::step(std::span<const double> bridgeForces) noexcept {
 #pragma omp simd reduction(+ : after)
   for (int k = 0; k < n; ++k) after += bridgeForces[k] * wNext[k];
   supplied_ += 0.5 * (after - before);
+  if (++sinceCheck_ == kCheckEvery) sleepQuietKeys();
+}
+
+void PianoBody::sleepQuietKeys() noexcept {
+  sinceCheck_ = 0;
+  const Eigen::VectorXd& w = board_.displacements();
+  const Eigen::VectorXd& wPrev = board_.previousDisplacements();
+  const double floor = std::max(quietFloor_, quietRelative_ * energy());
+  bool changed = false;
+  for (int key = 0; key < keys(); ++key)
+    if (strings_.coupled(key) && strings_.damped(key) &&
+        strings_.ringingEnergy(key, w[key], wPrev[key]) < floor) {
+      switched_ -= strings_.sleep(key, w[key], wPrev[key]);
+      changed = true;
+    }
+  if (changed) updateActivePoints();
+}
+
+void PianoBody::updateActivePoints() noexcept {
+  active_.clear();  // within the capacity reserved in prepare
+  for (int key = 0; key < keys(); ++key)
+    if (strings_.coupled(key) || strings_.excluded(key)) active_.push_back(key);
+  board_.setActivePoints(active_);
+}
+
+void PianoBody::setDamper(int key, double contact) noexcept {
+  strings_.setDamper(key, contact);
+  if (strings_.asleep(key) && !strings_.damped(key)) {
+    board_.refreshPoint(key);
+    switched_ -= strings_.wake(key, board_.displacement(key), board_.previousDisplacements()[key]);
+    updateActivePoints();
+  }
 }
 
 void PianoBody::setExcluded(int key, bool excluded) noexcept {
-  switched_ -=
-      strings_.setExcluded(key, excluded, board_.displacements(), board_.previousDisplacements());
+  board_.refreshPoint(key);  // it may have been asleep, out of use
+  switched_ -= strings_.setExcluded(key, excluded, board_.displacement(key),
+                                    board_.previousDisplacements()[key]);
+  updateActivePoints();
 }
 
 double PianoBody::energy() const noexcept {

@@ -30,10 +30,24 @@ class PianoBody {
   void step(std::span<const double> bridgeForces) noexcept;  // one force per key point, N
   void output(double& left, double& right) const noexcept { board_.pickups(left, right); }
 
-  void setDamper(int key, double contact) noexcept { strings_.setDamper(key, contact); }
+  // Lifting a sleeping key's damper wakes it (below).
+  void setDamper(int key, double contact) noexcept;
   // A key a voice is playing: its sympathetic strings leave the coupling; the energy they take
-  // away (or bring back) is booked in dissipated(), so the balance holds across the switch.
+  // away (or bring back) is booked in dissipated(), so the balance holds across the switch. Its
+  // point stays in use: the voice reads displacement(key) and drives it.
   void setExcluded(int key, bool excluded) noexcept;
+  // Points in use, so the cost is modes × (1 + points in use): every 256 steps a key whose damper
+  // is on and whose strings ring (about the shape the bridge gives them) with less than the floor
+  // (J) sleeps — it leaves the coupling, booked like an exclusion — until its damper lifts. Keys
+  // without dampers never sleep. The floor is the larger of `joules` and `relative` times the
+  // body's energy: damped strings still ring a little while the voices drive the board (about
+  // 1e-3 of it each, measured), so only a relative floor lets them sleep then — at the price of
+  // that ring.
+  void setQuietFloor(double joules, double relative = 0.0) noexcept {
+    quietFloor_ = joules;
+    quietRelative_ = relative;
+  }
+  int pointsInUse() const noexcept { return board_.activePoints(); }
 
   double energy() const noexcept;  // H^{n+½}: board + strings + coupling, J
   double dissipated() const noexcept {
@@ -49,8 +63,13 @@ class PianoBody {
  private:
   Soundboard board_;
   SympatheticStrings strings_;
+  void sleepQuietKeys() noexcept;
+  void updateActivePoints() noexcept;
   Eigen::VectorXd forces_;  // the strings' (Y4), per point
+  std::vector<int> active_;
   double supplied_ = 0.0, switched_ = 0.0;
+  double quietFloor_ = 1e-12, quietRelative_ = 0.0;
+  int sinceCheck_ = 0;
 };
 
 }  // namespace hamiltone

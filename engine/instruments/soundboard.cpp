@@ -117,6 +117,9 @@ void Soundboard::prepare(const SoundboardPhysics& p, double sampleRate,
   force_.resize(pointCount);
   w_.resize(pointCount);
   wPrev_.resize(pointCount);
+  active_.resize(pointCount);
+  for (int k = 0; k < pointCount; ++k) active_[k] = k;
+  activeCount_ = pointCount;
   reset();
 }
 
@@ -167,8 +170,19 @@ void Soundboard::step() noexcept {
   supplied_ += 0.5 * work;  // Σ_k F_k (w^{n+1} − w^{n−1})/2 = Σ_m g_m (a^{n+1} − a^{n−1})/2
   a_.swap(aPrev_);
   wPrev_.swap(w_);
-  loops_->gather(phi_.data(), n, points, n, a_.data(), w_.data());  // w = Φ a^{n+1}
+  loops_->gather(phi_.data(), n, active_.data(), activeCount_, n, a_.data(), w_.data());  // w = Φa
   force_.setZero();
+}
+
+void Soundboard::setActivePoints(std::span<const int> points) noexcept {
+  activeCount_ = static_cast<int>(std::min(points.size(), active_.size()));
+  std::copy_n(points.begin(), activeCount_, active_.begin());
+}
+
+void Soundboard::refreshPoint(int point) noexcept {
+  const long n = a_.size();
+  loops_->gather(phi_.data(), n, &point, 1, n, a_.data(), w_.data());
+  loops_->gather(phi_.data(), n, &point, 1, n, aPrev_.data(), wPrev_.data());
 }
 
 void Soundboard::pickups(double& left, double& right) const noexcept {

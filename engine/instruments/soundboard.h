@@ -43,6 +43,12 @@ class Soundboard {
   void reset() noexcept;  // the board at rest, the tallies zero; keeps the modes
 
   int points() const noexcept { return static_cast<int>(phi_.rows()); }
+  // The points in use (all after prepare): step() computes w at these only, the others keep
+  // stale values; forces belong at points in use. Copies; no allocation.
+  void setActivePoints(std::span<const int> points) noexcept;
+  int activePoints() const noexcept { return activeCount_; }
+  // w and the previous level's w at one point, brought up to date (before it is put in use).
+  void refreshPoint(int point) noexcept;
   double displacement(int point) const noexcept { return w_[point]; }  // w_k at level n
   const Eigen::VectorXd& displacements() const noexcept { return w_; }
   const Eigen::VectorXd& previousDisplacements() const noexcept { return wPrev_; }  // w^{n−1}
@@ -85,6 +91,8 @@ class Soundboard {
   const BodyLoops* loops_ = nullptr;
   Eigen::Matrix<double, 2, Eigen::Dynamic, Eigen::RowMajor> pickupShapes_;
   Eigen::VectorXd a_, aPrev_, g_, force_, w_, wPrev_;
+  std::vector<int> active_;  // points in use, active_[0 … activeCount_)
+  int activeCount_ = 0;
   double dissipated_ = 0.0, supplied_ = 0.0;
 };
 

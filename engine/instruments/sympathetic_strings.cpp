@@ -151,11 +151,16 @@ void SympatheticStrings::prepare(std::span<const SympatheticKey> keys, const Sou
   bPrev_.resize(total);
   contact_.assign(keyCount, 0.0);
   excluded_.assign(keyCount, 0);
+  asleep_.assign(keyCount, 0);
   for (int key = 0; key < keyCount; ++key) setCoefficients(key);
   reset();
 }
 
 void SympatheticStrings::reset() noexcept {
+  for (int key = 0; key < keys_; ++key) {  // every key not excluded coupled again
+    asleep_[key] = 0;
+    couple(key, 0.0, 0.0);
+  }
   b_.setZero();
   bPrev_.setZero();
   lost_.setZero();
@@ -193,6 +198,18 @@ double SympatheticStrings::keyEnergy(int key) const noexcept {
   return h;
 }
 
+double SympatheticStrings::ringingEnergy(int key, double w, double wPrev) const noexcept {
+  double h = 0.0;
+  for (int n = 1; n <= partials_[key]; ++n) {
+    const Eigen::Index j = slot(key, n);
+    const double now = b_[j] + c_[j] * w / stiffness_[j];
+    const double before = bPrev_[j] + c_[j] * wPrev / stiffness_[j];
+    const double d = (now - before) / k_;
+    h += 0.5 * (mass_[j] * d * d + stiffness_[j] * now * before);
+  }
+  return h;
+}
+
 // Key k's share of (Y5), w = w^{n+1}, wPrev = w^n.
 double SympatheticStrings::keyCoupling(int key, double w, double wPrev) const noexcept {
   double h = 0.5 * kappa_[key] * w * wPrev;
@@ -203,20 +220,38 @@ double SympatheticStrings::keyCoupling(int key, double w, double wPrev) const no
   return h;
 }
 
-double SympatheticStrings::setExcluded(int key, bool excluded, const Eigen::VectorXd& w,
-                                       const Eigen::VectorXd& wPrev) noexcept {
-  if (excluded == (excluded_[key] != 0)) return 0.0;
-  const double before = keyEnergy(key) + keyCoupling(key, w[key], wPrev[key]);
-  excluded_[key] = excluded;
-  kappa_[key] = excluded ? 0.0 : kappaOn_[key];
+double SympatheticStrings::couple(int key, double w, double wPrev) noexcept {
+  const bool on = coupled(key);
+  if (on == (kappa_[key] != 0.0)) return 0.0;
+  const double before = keyEnergy(key) + keyCoupling(key, w, wPrev);
+  kappa_[key] = on ? kappaOn_[key] : 0.0;
   for (int n = 1; n <= partials_[key]; ++n) {
     const Eigen::Index j = slot(key, n);
-    c_[j] = excluded ? 0.0 : cOn_[j];
+    c_[j] = on ? cOn_[j] : 0.0;
     // Back at rest on the board: the static shape u = w x/L, a_n = −C_n w/K̂_n.
-    b_[j] = excluded ? 0.0 : -c_[j] * w[key] / stiffness_[j];
-    bPrev_[j] = excluded ? 0.0 : -c_[j] * wPrev[key] / stiffness_[j];
+    b_[j] = on ? -c_[j] * w / stiffness_[j] : 0.0;
+    bPrev_[j] = on ? -c_[j] * wPrev / stiffness_[j] : 0.0;
   }
-  return keyEnergy(key) + keyCoupling(key, w[key], wPrev[key]) - before;
+  return keyEnergy(key) + keyCoupling(key, w, wPrev) - before;
+}
+
+double SympatheticStrings::setExcluded(int key, bool excluded, double w, double wPrev) noexcept {
+  excluded_[key] = excluded;
+  return couple(key, w, wPrev);
+}
+
+double SympatheticStrings::sleep(int key, double w, double wPrev) noexcept {
+  asleep_[key] = 1;
+  return couple(key, w, wPrev);
+}
+
+double SympatheticStrings::wake(int key, double w, double wPrev) noexcept {
+  asleep_[key] = 0;
+  return couple(key, w, wPrev);
+}
+
+bool SympatheticStrings::damped(int key) const noexcept {
+  return contact_[key] >= 1.0 && !std::isinf(data_[key].damperT60);
 }
 
 void SympatheticStrings::step(const Eigen::VectorXd& w, std::span<double> forces) noexcept {

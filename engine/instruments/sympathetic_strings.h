@@ -63,10 +63,19 @@ class SympatheticStrings {
   // 0: lifted (the string's own loss), 1: the damper on (its T60); between, σ blends linearly.
   void setDamper(int key, double contact) noexcept;
   // An excluded key's strings leave the coupling (a voice plays them); it returns at rest on the
-  // board, statically attached. The jump in H_strings + H_c is returned (J): PianoBody books it.
-  double setExcluded(int key, bool excluded, const Eigen::VectorXd& w,
-                     const Eigen::VectorXd& wPrev) noexcept;
+  // board, statically attached. w, wPrev: the key's w^{n+1}, w^n. The jump in H_strings + H_c is
+  // returned (J): PianoBody books it.
+  double setExcluded(int key, bool excluded, double w, double wPrev) noexcept;
   bool excluded(int key) const noexcept { return excluded_[key] != 0; }
+  // A damped key gone quiet sleeps: it leaves the coupling like an excluded one, so the board
+  // need not compute w at its point; it wakes, at rest on the board, when its damper lifts.
+  // Both return the jump in H_strings + H_c, J.
+  double sleep(int key, double w, double wPrev) noexcept;
+  double wake(int key, double w, double wPrev) noexcept;
+  bool asleep(int key) const noexcept { return asleep_[key] != 0; }
+  bool coupled(int key) const noexcept { return !excluded_[key] && !asleep_[key]; }
+  // The damper fully on (a key without one never is).
+  bool damped(int key) const noexcept;
 
   // (Y3): level n → n+1 given w = w^n; adds the strings' forces (Y4) at level n on the board's
   // points to `forces`, N (one pass over the partials for both).
@@ -77,6 +86,9 @@ class SympatheticStrings {
   double dissipated() const noexcept;  // J; a sum over the partials, not for every sample
   // One key's string energy Σ M/2 (δt₋ a)² + K̂/2 a^n a^{n−1}, J (no coupling term).
   double keyEnergy(int key) const noexcept;
+  // The same of its motion about the bridge's static shape, a_n + C_n w/K̂_n (w, wPrev: w^{n+1},
+  // w^n): what rings, not what merely follows the board; J.
+  double ringingEnergy(int key, double w, double wPrev) const noexcept;
 
   int keys() const noexcept { return keys_; }
   int partials(int key) const noexcept { return partials_[key]; }
@@ -90,6 +102,7 @@ class SympatheticStrings {
     return static_cast<Eigen::Index>(n - 1) * keys_ + key;
   }
   void setCoefficients(int key) noexcept;
+  double couple(int key, double w, double wPrev) noexcept;  // applies coupled(key); the jump
   double keyCoupling(int key, double w, double wPrev) const noexcept;
   std::vector<SympatheticKey> data_;
   double k_ = 0.0;
@@ -97,7 +110,7 @@ class SympatheticStrings {
   std::vector<int> partials_, rowLength_;
   const BodyLoops* loops_ = nullptr;
   std::vector<double> contact_;
-  std::vector<char> excluded_;
+  std::vector<char> excluded_, asleep_;
   Eigen::VectorXd kappa_, kappaOn_;  // κ_k in use (0 when excluded) and as prepared
   // Per partial slot (n − 1) keys + key: mass, K̂, ω, own σ, σ in use, coupling in use and as
   // prepared, step coefficients.

@@ -127,6 +127,42 @@ struct CoupledMode {
   double hz, sigma;
 };
 
+// Dampers down, one key played by a voice (excluded): the damped keys fall asleep once quiet (the
+// board's slowest modes take 2.5 s) and leave the board's products (points in use: the voice's key
+// and the 20 keys without dampers), one wakes when its damper lifts, and the balance holds through
+// it all, the switches booked.
+TEST(SympatheticStrings, QuietDampedKeysSleepAndWakeKeepingTheBalance) {
+  PianoBody body = preparedBody(grandSympatheticKeys());
+  const int c4 = 60 - kA0, c5 = 72 - kA0;
+  for (int k = 0; k < body.keys(); ++k) body.setDamper(k, 1.0);
+  body.setExcluded(c4, true);
+  std::vector<double> f(body.keys(), 0.0);
+  double scale = 0.0, worst = 0.0;
+  bool sleptC5 = false;
+  int fewest = body.keys();
+  const int steps = static_cast<int>(3.0 * kRate), lift = static_cast<int>(2.5 * kRate);
+  for (int n = 0; n < steps; ++n) {
+    f[c4] = n < 6000 ? 20.0 * std::sin(2 * kPi * 261.6 * n / kRate) * std::exp(-n / 4000.0) : 0.0;
+    if (n == lift) {
+      sleptC5 = body.strings().asleep(c5);
+      fewest = body.pointsInUse();
+      body.setDamper(c5, 0.0);  // wakes it
+    }
+    body.step(f);
+    const double h = body.energy();
+    scale = std::max({scale, std::abs(h), body.dissipated(), body.supplied()});
+    worst = std::max(worst, std::abs(h + body.dissipated() - body.supplied()));
+  }
+  std::printf("points in use after 2.5 s: %d, at 3 s %d; balance residual %.3g\n", fewest,
+              body.pointsInUse(), worst / scale);
+  EXPECT_TRUE(sleptC5);
+  EXPECT_EQ(fewest, 1 + 20);  // C4's voice and F6 … C8
+  EXPECT_FALSE(body.strings().asleep(c5));
+  EXPECT_TRUE(body.strings().coupled(c5));
+  EXPECT_EQ(body.pointsInUse(), 22);  // and C5
+  EXPECT_LT(worst, 1e-12 * scale);
+}
+
 // |Σ_n a_n e^{−iωn/fs}| over [from, to) with a Hann window: the partial's component at hz.
 double component(const std::vector<double>& a, int from, int to, double hz) {
   std::complex<double> sum = 0.0;
