@@ -18,21 +18,33 @@ void PianoBody::prepare(const PianoBodySpec& spec, std::span<const BoardPoint> b
                    spec.sympatheticMaxPartials);
   forces_.setZero(board_.points());
   active_.reserve(board_.points());
+  driven_.assign(board_.points(), 0);
   reset();
 }
 
 void PianoBody::reset() noexcept {
   board_.reset();
   strings_.reset();
+  std::fill(driven_.begin(), driven_.end(), 0);
   updateActivePoints();
   supplied_ = switched_ = 0.0;
   sinceCheck_ = 0;
 }
 
 void PianoBody::step(std::span<const double> bridgeForces) noexcept {
-  const Eigen::VectorXd& w = board_.displacements();  // w^n; after board_.step(), w^{n+1}
   const int n = board_.points();
-  double before = 0.0;  // Σ F_k w_k^{n−1}
+  bool newlyDriven = false;
+  for (int k = 0; k < n; ++k)
+    if (bridgeForces[k] != 0.0 && !driven_[k]) {
+      driven_[k] = 1;
+      if (!strings_.coupled(k) && !strings_.excluded(k)) {  // out of use until now
+        board_.refreshPoint(k);
+        newlyDriven = true;
+      }
+    }
+  if (newlyDriven) updateActivePoints();
+  const Eigen::VectorXd& w = board_.displacements();  // w^n; after board_.step(), w^{n+1}
+  double before = 0.0;                                // Σ F_k w_k^{n−1}
   const double* wPrev = board_.previousDisplacements().data();
 #pragma omp simd reduction(+ : before)
   for (int k = 0; k < n; ++k) before += bridgeForces[k] * wPrev[k];
@@ -67,7 +79,7 @@ void PianoBody::sleepQuietKeys() noexcept {
 void PianoBody::updateActivePoints() noexcept {
   active_.clear();  // within the capacity reserved in prepare
   for (int key = 0; key < keys(); ++key)
-    if (strings_.coupled(key) || strings_.excluded(key)) active_.push_back(key);
+    if (strings_.coupled(key) || strings_.excluded(key) || driven_[key]) active_.push_back(key);
   board_.setActivePoints(active_);
 }
 

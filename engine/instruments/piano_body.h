@@ -27,7 +27,8 @@ class PianoBody {
                std::span<const SympatheticKey> keys);
   void reset() noexcept;
 
-  void step(std::span<const double> bridgeForces) noexcept;  // one force per key point, N
+  // One force per key point, N. A key once driven stays a point in use (until reset()).
+  void step(std::span<const double> bridgeForces) noexcept;
   void output(double& left, double& right) const noexcept { board_.pickups(left, right); }
 
   // Lifting a sleeping key's damper wakes it (below).
@@ -40,8 +41,8 @@ class PianoBody {
   // is on and whose strings ring (about the shape the bridge gives them) with less than the floor
   // (J) sleeps — it leaves the coupling, booked like an exclusion — until its damper lifts. Keys
   // without dampers never sleep. The floor is the larger of `joules` and `relative` times the
-  // body's energy: damped strings still ring a little while the voices drive the board (about
-  // 1e-3 of it each, measured), so only a relative floor lets them sleep then — at the price of
+  // body's energy: damped strings still ring a little while the voices drive the board (1e-3 to
+  // 1e-2 of it each, measured), so only a relative floor lets them sleep then — at the price of
   // that ring.
   void setQuietFloor(double joules, double relative = 0.0) noexcept {
     quietFloor_ = joules;
@@ -67,6 +68,7 @@ class PianoBody {
   void updateActivePoints() noexcept;
   Eigen::VectorXd forces_;  // the strings' (Y4), per point
   std::vector<int> active_;
+  std::vector<char> driven_;  // keys a force has reached: their points stay in use
   double supplied_ = 0.0, switched_ = 0.0;
   double quietFloor_ = 1e-12, quietRelative_ = 0.0;
   int sinceCheck_ = 0;

@@ -72,9 +72,8 @@ class Soundboard {
   double modeStiffness(int mode) const noexcept { return mass_ * omegaHat2_[mode]; }  // K̂_m
   double modeAmplitude(int mode) const noexcept { return a_[mode]; }                  // a_m^n
   double shape(int mode, const BoardPoint& p) const noexcept;                         // φ_m(x, y)
-  const Eigen::MatrixXd& shapes() const noexcept {
-    return phiColumns_;
-  }  // φ_m(x_k): modes × points
+  // φ_m(x_k) as the products use them (rounded to float), modes × points.
+  const Eigen::MatrixXd& shapes() const noexcept { return phiColumns_; }
   double timeStep() const noexcept { return k_; }
   const SoundboardPhysics& physics() const noexcept { return physics_; }
 

@@ -161,6 +161,17 @@ TEST(SympatheticStrings, QuietDampedKeysSleepAndWakeKeepingTheBalance) {
   EXPECT_TRUE(body.strings().coupled(c5));
   EXPECT_EQ(body.pointsInUse(), 22);  // and C5
   EXPECT_LT(worst, 1e-12 * scale);
+  // A force at a sleeping key (A0) puts its point back in use, and the balance still holds.
+  ASSERT_TRUE(body.strings().asleep(0));
+  for (int n = 0; n < 2000; ++n) {
+    f[0] = n < 500 ? std::sin(0.01 * n) : 0.0;
+    body.step(f);
+    const double h = body.energy();
+    scale = std::max({scale, std::abs(h), body.dissipated(), body.supplied()});
+    worst = std::max(worst, std::abs(h + body.dissipated() - body.supplied()));
+  }
+  EXPECT_EQ(body.pointsInUse(), 23);
+  EXPECT_LT(worst, 1e-12 * scale);
 }
 
 // |Σ_n a_n e^{−iωn/fs}| over [from, to) with a Hann window: the partial's component at hz.
