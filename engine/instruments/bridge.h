@@ -1,5 +1,5 @@
 // The bridge the strings of a key end on: a mass on a spring with a resistance (the soundboard's
-// driving point, docs/instrument-data.md §5), and the string–bridge coupling that keeps the
+// driving point, docs/instrument-data.md §6), and the string–bridge coupling that keeps the
 // strings' scheme (38) and the bridge together exactly energy-conserving.
 #pragma once
 

@@ -168,7 +168,7 @@ constexpr Parameter kTable[] = {
      .model = kString,
      .perKey = true,
      .doc = "Mass of the bridge the key's unison strings end on (the soundboard's driving point, "
-            "docs/instrument-data.md §5); 0: rigid ends, each string alone."},
+            "docs/instrument-data.md §6); 0: rigid ends, each string alone."},
     {.name = "bridge.stiffness_N_m",
      .unit = "N/m",
      .min = 0,

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "instruments/hammer.h"
+#include "instruments/piano_body.h"
 #include "instruments/piano_scale.h"
 #include "instruments/plate.h"
 #include "schemes/variable_step_sav.h"
@@ -302,6 +303,31 @@ TEST(NoAllocation, MarazzatoWithEveryQuadrature) {
     forbidAllocation(false);
     EXPECT_GT(d, 0.0);
   }
+}
+
+// The piano's body: the board and the 88 keys' sympathetic strings stepped, read, damped and
+// excluded on the audio thread.
+TEST(NoAllocation, PianoBodyStep) {
+  const PianoBodySpec spec;
+  PianoBody body;
+  body.prepare(spec, bridgeLine(21, 108, spec.board), grandSympatheticKeys());
+  std::vector<double> forces(body.keys(), 0.0);
+  double sink = 0.0;
+  const long before = forbiddenNews;
+  forbidAllocation(true);
+  for (int n = 0; n < 2000; ++n) {
+    forces[39] = std::sin(0.05 * n);
+    if (n == 100) body.setDamper(51, 0.0);
+    if (n == 200) body.setExcluded(39, true);
+    body.step(forces);
+    double l = 0.0, r = 0.0;
+    body.output(l, r);
+    sink += l + r + body.energy() + body.dissipated() + body.supplied();
+  }
+  body.reset();
+  forbidAllocation(false);
+  EXPECT_EQ(forbiddenNews - before, 0);
+  EXPECT_TRUE(std::isfinite(sink));
 }
 
 }  // namespace

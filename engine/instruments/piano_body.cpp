@@ -1,0 +1,106 @@
+// The piano's body: one step of the soundboard and the sympathetic strings together.
+#include "instruments/piano_body.h"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+namespace hamiltone {
+
+namespace {
+constexpr int kCheckEvery = 256;  // steps between looks for quiet damped keys
+}  // namespace
+
+void PianoBody::prepare(const PianoBodySpec& spec, std::span<const BoardPoint> bridgePoints,
+                        std::span<const SympatheticKey> keys) {
+  board_.prepare(spec.board, spec.sampleRate, bridgePoints, spec.pickups);
+  strings_.prepare(keys, board_, spec.sampleRate, spec.sympatheticMaxHz,
+                   spec.sympatheticMaxPartials);
+  forces_.setZero(board_.points());
+  active_.reserve(board_.points());
+  driven_.assign(board_.points(), 0);
+  reset();
+}
+
+void PianoBody::reset() noexcept {
+  board_.reset();
+  strings_.reset();
+  std::fill(driven_.begin(), driven_.end(), 0);
+  updateActivePoints();
+  supplied_ = switched_ = 0.0;
+  sinceCheck_ = 0;
+}
+
+void PianoBody::step(std::span<const double> bridgeForces) noexcept {
+  const int n = board_.points();
+  bool newlyDriven = false;
+  for (int k = 0; k < n; ++k)
+    if (bridgeForces[k] != 0.0 && !driven_[k]) {
+      driven_[k] = 1;
+      if (!strings_.coupled(k) && !strings_.excluded(k)) {  // out of use until now
+        board_.refreshPoint(k);
+        newlyDriven = true;
+      }
+    }
+  if (newlyDriven) updateActivePoints();
+  const Eigen::VectorXd& w = board_.displacements();  // w^n; after board_.step(), w^{n+1}
+  double before = 0.0;                                // Σ F_k w_k^{n−1}
+  const double* wPrev = board_.previousDisplacements().data();
+#pragma omp simd reduction(+ : before)
+  for (int k = 0; k < n; ++k) before += bridgeForces[k] * wPrev[k];
+  forces_.setZero();
+  strings_.step(w, {forces_.data(), static_cast<std::size_t>(n)});  // (Y3), (Y4) with w^n
+  board_.addForces({forces_.data(), static_cast<std::size_t>(n)});
+  board_.addForces(bridgeForces);
+  board_.step();
+  double after = 0.0;  // Σ F_k w_k^{n+1}
+  const double* wNext = board_.displacements().data();
+#pragma omp simd reduction(+ : after)
+  for (int k = 0; k < n; ++k) after += bridgeForces[k] * wNext[k];
+  supplied_ += 0.5 * (after - before);
+  if (++sinceCheck_ == kCheckEvery) sleepQuietKeys();
+}
+
+void PianoBody::sleepQuietKeys() noexcept {
+  sinceCheck_ = 0;
+  const Eigen::VectorXd& w = board_.displacements();
+  const Eigen::VectorXd& wPrev = board_.previousDisplacements();
+  const double floor = std::max(quietFloor_, quietRelative_ * energy());
+  bool changed = false;
+  for (int key = 0; key < keys(); ++key)
+    if (strings_.coupled(key) && strings_.damped(key) &&
+        strings_.ringingEnergy(key, w[key], wPrev[key]) < floor) {
+      switched_ -= strings_.sleep(key, w[key], wPrev[key]);
+      changed = true;
+    }
+  if (changed) updateActivePoints();
+}
+
+void PianoBody::updateActivePoints() noexcept {
+  active_.clear();  // within the capacity reserved in prepare
+  for (int key = 0; key < keys(); ++key)
+    if (strings_.coupled(key) || strings_.excluded(key) || driven_[key]) active_.push_back(key);
+  board_.setActivePoints(active_);
+}
+
+void PianoBody::setDamper(int key, double contact) noexcept {
+  strings_.setDamper(key, contact);
+  if (strings_.asleep(key) && !strings_.damped(key)) {
+    board_.refreshPoint(key);
+    switched_ -= strings_.wake(key, board_.displacement(key), board_.previousDisplacements()[key]);
+    updateActivePoints();
+  }
+}
+
+void PianoBody::setExcluded(int key, bool excluded) noexcept {
+  board_.refreshPoint(key);  // it may have been asleep, out of use
+  switched_ -= strings_.setExcluded(key, excluded, board_.displacement(key),
+                                    board_.previousDisplacements()[key]);
+  updateActivePoints();
+}
+
+double PianoBody::energy() const noexcept {
+  return board_.energy() + strings_.energy(board_.displacements(), board_.previousDisplacements());
+}
+
+}  // namespace hamiltone

@@ -1,0 +1,77 @@
+// The piano's body: the soundboard and the sympathetic strings as one linear conservative system,
+// stepped once per sample on one thread; the keys' voices drive it with their bridge forces.
+#pragma once
+
+#include <span>
+
+#include "instruments/soundboard.h"
+#include "instruments/sympathetic_strings.h"
+
+namespace hamiltone {
+
+struct PianoBodySpec {
+  SoundboardPhysics board;
+  double sampleRate = 48000.0;
+  double sympatheticMaxHz = 4500.0;  // partials up to here (< fs/4): C8's fundamental too …
+  int sympatheticMaxPartials = 16;   // … and at most this many per key
+  BoardPoint pickups[2] = {{0.45, 0.35}, {1.2, 0.9}};  // m
+};
+
+// One step: the board takes the voices' forces F_ext and the strings' (Y4), both at level n, the
+// strings take w^n; then both advance. H_board + H_strings + H_c + dissipated − supplied is
+// constant to roundoff, supplied = Σ_n Σ_k F_ext,k^n (w_k^{n+1} − w_k^{n−1})/2.
+class PianoBody {
+ public:
+  // May allocate; one key per bridge point. Throws std::invalid_argument (see the parts).
+  void prepare(const PianoBodySpec& spec, std::span<const BoardPoint> bridgePoints,
+               std::span<const SympatheticKey> keys);
+  void reset() noexcept;
+
+  // One force per key point, N. A key once driven stays a point in use (until reset()).
+  void step(std::span<const double> bridgeForces) noexcept;
+  void output(double& left, double& right) const noexcept { board_.pickups(left, right); }
+
+  // Lifting a sleeping key's damper wakes it (below).
+  void setDamper(int key, double contact) noexcept;
+  // A key a voice is playing: its sympathetic strings leave the coupling; the energy they take
+  // away (or bring back) is booked in dissipated(), so the balance holds across the switch. Its
+  // point stays in use: the voice reads displacement(key) and drives it.
+  void setExcluded(int key, bool excluded) noexcept;
+  // Points in use, so the cost is modes × (1 + points in use): every 256 steps a key whose damper
+  // is on and whose strings ring (about the shape the bridge gives them) with less than the floor
+  // (J) sleeps — it leaves the coupling, booked like an exclusion — until its damper lifts. Keys
+  // without dampers never sleep. The floor is the larger of `joules` and `relative` times the
+  // body's energy: damped strings still ring a little while the voices drive the board (1e-3 to
+  // 1e-2 of it each, measured), so only a relative floor lets them sleep then — at the price of
+  // that ring.
+  void setQuietFloor(double joules, double relative = 0.0) noexcept {
+    quietFloor_ = joules;
+    quietRelative_ = relative;
+  }
+  int pointsInUse() const noexcept { return board_.activePoints(); }
+
+  double energy() const noexcept;  // H^{n+½}: board + strings + coupling, J
+  double dissipated() const noexcept {
+    return board_.dissipated() + strings_.dissipated() + switched_;
+  }
+  double supplied() const noexcept { return supplied_; }
+
+  int keys() const noexcept { return board_.points(); }
+  double displacement(int key) const noexcept { return board_.displacement(key); }
+  const Soundboard& board() const noexcept { return board_; }
+  const SympatheticStrings& strings() const noexcept { return strings_; }
+
+ private:
+  Soundboard board_;
+  SympatheticStrings strings_;
+  void sleepQuietKeys() noexcept;
+  void updateActivePoints() noexcept;
+  Eigen::VectorXd forces_;  // the strings' (Y4), per point
+  std::vector<int> active_;
+  std::vector<char> driven_;  // keys a force has reached: their points stay in use
+  double supplied_ = 0.0, switched_ = 0.0;
+  double quietFloor_ = 1e-12, quietRelative_ = 0.0;
+  int sinceCheck_ = 0;
+};
+
+}  // namespace hamiltone
