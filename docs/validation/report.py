@@ -41,6 +41,7 @@ SECTIONS = [
     "instrument",    # the synthesizer: piano brightness, inharmonicity, pitch glide, gong
     "string_grids",  # the string's grid rules on the piano: glide, phantom partials, cost
     "dynamics",      # loudness across velocity and register; the fortissimo passage's headroom
+    "body",          # the bridge's two-stage decay, the pedal's sympathetic ring
 ]
 
 

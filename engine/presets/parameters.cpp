@@ -187,6 +187,35 @@ constexpr Parameter kTable[] = {
      .doc = "The bridge's resistance, where the strings' energy leaves for the soundboard: "
             "unisons in phase drain n times faster than alone (the prompt sound)."},
 
+    {.name = "body.enabled",
+     .type = boolean,
+     .defaultText = "false",
+     .model = kString,
+     .doc = "A soundboard driven by the keys' bridges (bridge.mass_kg > 0), every key's strings "
+            "ringing in sympathy on it, heard at its pickups beside the strings' own."},
+    {.name = "body.gain",
+     .min = -1e6,
+     .max = 1e6,
+     .defaultText = "1",
+     .model = kString,
+     .doc = "Output units per m/s of the soundboard at its pickups."},
+    {.name = "body.max_mode_Hz",
+     .unit = "Hz",
+     .min = 50,
+     .max = 8000,
+     .defaultText = "1000",
+     .model = kString,
+     .doc = "The soundboard's modes up to here: its cost grows with modes × keys in use "
+            "(docs/instrument-data.md §6.4)."},
+    {.name = "body.sympathetic_max_Hz",
+     .unit = "Hz",
+     .min = 50,
+     .max = 20000,
+     .defaultText = "4500",
+     .model = kString,
+     .doc = "The sympathetic strings' partials up to here, at most 16 a key; below a quarter of "
+            "the sample rate."},
+
     {.name = "hammer.mass_kg",
      .unit = "kg",
      .min = 1e-4,

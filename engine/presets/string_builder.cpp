@@ -8,6 +8,7 @@
 #include <set>
 #include <string>
 
+#include "synth/instrument_body.h"
 #include "voices/string_voice.h"
 
 namespace hamiltone {
@@ -37,6 +38,9 @@ constexpr VoiceField kStringFields[] = {
     {"grid factor", "scheme.grid_factor"},
     {"hammer mass", "hammer.mass_kg"},
     {"bridge_mass_kg", "bridge.mass_kg"},
+    {"body.enabled", "body.enabled"},
+    {"soundboard maxModeHz", "body.max_mode_Hz"},
+    {"sympathetic maxHz", "body.sympathetic_max_Hz"},
     {"bridge_stiffness_N_m", "bridge.stiffness_N_m"},
     {"bridge_resistance_kg_s", "bridge.resistance_kg_s"},
     {"hammer stiffness", "hammer.stiffness_N_per_m_p"},
@@ -77,6 +81,10 @@ void buildStringKeys(const PresetValues& values, Instrument& instrument) {
   common.hammer.width = number("hammer.width_m");
   common.string.young = number("string.young_Pa");
   const bool stiff = number("string.bending_stiffness") != 0.0;
+  instrument.body = {.enabled = number("body.enabled") != 0.0,
+                     .gain = number("body.gain"),
+                     .maxModeHz = number("body.max_mode_Hz"),
+                     .sympatheticMaxHz = number("body.sympathetic_max_Hz")};
   const Parameter& linearDensity = values.row("string.linear_density_kg_m");
   const bool densityGiven = values.setting(linearDensity.name) || values.anchored(linearDensity);
 
@@ -133,6 +141,12 @@ void checkStringVoices(const Instrument& instrument, const PresetValues& values,
       }
     } catch (const std::exception& e) {
       refused(e.what(), note);
+    }
+  if (instrument.body.enabled) try {
+      PianoBody body;
+      prepareBody(body, instrument, kCheckRate);
+    } catch (const std::exception& e) {
+      refused(e.what(), lo);
     }
 }
 

@@ -20,6 +20,16 @@ struct StringKey {
   BridgePhysics bridge;      // the strings' common end; mass 0: rigid ends, each string alone
 };
 
+// The piano's body (string instruments): the soundboard the keys' bridges drive, with every key's
+// strings ringing in sympathy on it (instruments/piano_body.h), heard at the board's two pickups
+// beside the strings' own.
+struct BodyPatch {
+  bool enabled = false;
+  double gain = 1.0;                 // output units per m/s of the board at its pickups
+  double maxModeHz = 1000.0;         // the board's modes up to here (its cost: modes × keys)
+  double sympatheticMaxHz = 4500.0;  // the sympathetic strings' partials up to here (< fs/4)
+};
+
 struct Instrument {
   std::string name;    // shown to the player
   std::string source;  // the preset file it came from
@@ -31,6 +41,7 @@ struct Instrument {
   double gainDb = 0.0;                     // applied to the sum of the voices
   double bendRange = 2.0;                  // semitones each way of the pitch wheel (strings)
   double panSpread = 0.5;                  // 0: all centred; 1: lowest key left … highest right
+  BodyPatch body;                          // string instruments only
 };
 
 // The patch of unison string `string` (0 … unisons−1) of `note`, as the synthesizer plays it: the

@@ -34,7 +34,7 @@ void KeyVoice::prepare(const Instrument& instrument, int note, double sampleRate
                        static_cast<double>(std::max<size_t>(strings ? strings->size() : 0, 1));
   const double floor = freeQuiet ? QuietDetector::kFloor / heard : -1.0;
   std::visit([floor](auto& v) { v.setQuietFloor(floor); }, voice_);
-  for (auto* buffer : {&mixLeft_, &mixRight_, &outLeft_, &outRight_})
+  for (auto* buffer : {&mixLeft_, &mixRight_, &outLeft_, &outRight_, &boardForce_})
     buffer->assign(maxBlock, 0.0f);
   frames_ = 0;
   fadeSamples_ = std::max(1, static_cast<int>(std::lround(kFadeS * sampleRate)));
@@ -121,7 +121,7 @@ void KeyVoice::process(size_t frames, double gain) noexcept {
     const bool wasFading = fading();
     size_t length = frames - done;
     if (wasFading) length = std::min(length, static_cast<size_t>(fadeLeft_));
-    render(left.subspan(done, length), right.subspan(done, length), gain);
+    render(done, length, gain);
     done += length;
     if (wasFading && !fading()) {  // free the voices; a pending strike starts next round
       std::visit([](auto& v) { v.reset(); }, voice_);
@@ -131,13 +131,18 @@ void KeyVoice::process(size_t frames, double gain) noexcept {
   // A key whose fade ended inside the piece is silent for the rest of it.
   std::fill(left.begin() + done, left.end(), 0.0f);
   std::fill(right.begin() + done, right.end(), 0.0f);
+  std::fill(boardForce_.begin() + done, boardForce_.begin() + frames, 0.0f);
 }
 
-void KeyVoice::render(std::span<float> left, std::span<float> right, double gain) noexcept {
-  const size_t n = left.size();
+void KeyVoice::render(size_t offset, size_t n, double gain) noexcept {
+  float* left = outLeft_.data() + offset;
+  float* right = outRight_.data() + offset;
+  float* force = boardForce_.data() + offset;
   std::span<float> mixL(mixLeft_.data(), n), mixR(mixRight_.data(), n);
+  const float* bridge = nullptr;
   if (UnisonStrings* strings = std::get_if<UnisonStrings>(&voice_)) {
     strings->process(mixL, mixR);  // silence when no string sounds
+    bridge = strings->boardForce().data();
   } else if (PlateVoice& plate = std::get<PlateVoice>(voice_); plate.active()) {
     plate.process(mixL, mixR);
   } else {
@@ -154,6 +159,7 @@ void KeyVoice::render(std::span<float> left, std::span<float> right, double gain
     const double fade = fadeLeft_ > 0 ? static_cast<double>(--fadeLeft_) / fadeSamples_ : 1.0;
     left[i] = static_cast<float>(gl * fade * mixL[i]);
     right[i] = static_cast<float>(gr * fade * mixR[i]);
+    force[i] = bridge ? static_cast<float>(fade * bridge[i]) : 0.0f;
   }
 }
 

@@ -40,6 +40,9 @@ class KeyVoice {
   void process(size_t frames, double gain) noexcept;
   std::span<const float> left() const { return {outLeft_.data(), frames_}; }  // the last process()
   std::span<const float> right() const { return {outRight_.data(), frames_}; }
+  // What the key's bridge passed to the soundboard over the last process(), N per sample (faded
+  // with the output); zeros for a key without a bridge.
+  std::span<const float> boardForce() const { return {boardForce_.data(), frames_}; }
 
   bool sounding() const;  // a voice of the key is active
   bool fading() const { return fadeLeft_ > 0; }
@@ -63,11 +66,11 @@ class KeyVoice {
   bool caught = false;
 
  private:
-  void render(std::span<float> left, std::span<float> right, double gain) noexcept;
+  void render(size_t offset, size_t frames, double gain) noexcept;  // into the outputs there
   void strikeNow(double velocity, bool unaCorda) noexcept;
 
   std::variant<UnisonStrings, PlateVoice> voice_;  // one voice type per instrument model
-  std::vector<float> mixLeft_, mixRight_, outLeft_, outRight_;
+  std::vector<float> mixLeft_, mixRight_, outLeft_, outRight_, boardForce_;
   size_t frames_ = 0;  // written to the outputs by the last process()
   double panLeft_ = 1.0, panRight_ = 1.0;
   int fadeSamples_ = 1, fadeLeft_ = 0;

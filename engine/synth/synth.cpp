@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "synth/denormals.h"
+#include "synth/instrument_body.h"
 
 namespace hamiltone {
 
@@ -52,6 +53,28 @@ void Synth::prepare(std::vector<Instrument> instruments, const SynthSetup& setup
     }
     gains.push_back(std::pow(10.0, instrument.gainDb / 20.0));
   }
+  std::vector<std::unique_ptr<Body>> bodies(instruments.size());
+  for (size_t p = 0; p < instruments.size(); ++p) {
+    const Instrument& instrument = instruments[p];
+    if (instrument.model != InstrumentModel::string || !instrument.body.enabled) continue;
+    auto body = std::make_unique<Body>();
+    try {
+      prepareBody(body->body, instrument, setup.sampleRate);
+    } catch (const std::exception& e) {
+      throw std::invalid_argument(instrument.source + ": " + e.what());
+    }
+    const size_t count = instrument.keys.size();
+    body->forces.assign(count, 0.0);
+    body->driving.assign(count, nullptr);
+    body->drivers.assign(count, 0);
+    body->excluded.assign(count, -1);
+    body->contact.assign(count, -1.0);
+    body->gain = instrument.body.gain * gains[p];
+    // A hundredth of the quiet floor at the output: ½ m v² of one mode at that pickup speed.
+    const double speed = 0.01 * QuietDetector::kFloor / std::max(std::abs(body->gain), 1e-30);
+    body->energyFloor = 0.5 * body->body.board().modalMass() * speed * speed;
+    bodies[p] = std::move(body);
+  }
   MasterBus master;
   master.prepare(setup.sampleRate);
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
@@ -63,6 +86,7 @@ void Synth::prepare(std::vector<Instrument> instruments, const SynthSetup& setup
   gains_ = std::move(gains);
   busy_.assign(keys, {});
   pool_ = std::move(pool);
+  bodies_ = std::move(bodies);
   master_ = master;
   maxBlock_ = setup.maxBlock;
   program_ = 0;
@@ -118,6 +142,8 @@ bool Synth::silent() const {
   for (const auto& keys : voices_)
     for (const KeyVoice& v : keys)
       if (v.busy()) return false;
+  for (const auto& body : bodies_)
+    if (body && !body->resting) return false;  // the board and its strings still ring
   return true;
 }
 
@@ -315,6 +341,51 @@ void Synth::render(std::span<float> left, std::span<float> right) noexcept {
       left[i] += keyLeft[i];
       right[i] += keyRight[i];
     }
+  }
+  for (size_t p = 0; p < bodies_.size(); ++p)
+    if (bodies_[p]) renderBody(p, left, right);
+}
+
+// The body after the keys: who sounds as a voice (its sympathetic strings leave the coupling, its
+// bridge drives the board instead), whose damper is off, then the board sample by sample.
+void Synth::renderBody(size_t program, std::span<float> left, std::span<float> right) noexcept {
+  Body& b = *bodies_[program];
+  int drivers = 0;
+  for (size_t key = 0; key < b.forces.size(); ++key) {
+    const KeyVoice& v = voices_[program][key];
+    const bool voiced = hasVoice_[program][key] && v.busy();
+    if (voiced) {
+      b.drivers[drivers] = static_cast<int>(key);
+      b.driving[drivers++] = v.boardForce().data();
+    }
+    b.forces[key] = 0.0;
+    if (static_cast<signed char>(voiced) != b.excluded[key]) {
+      b.body.setExcluded(static_cast<int>(key), voiced);
+      b.excluded[key] = voiced;
+    }
+    const double contact = (v.down || v.caught) ? 0.0 : contact_;  // the pedal lifts every damper
+    if (contact != b.contact[key]) {
+      b.body.setDamper(static_cast<int>(key), contact);
+      b.contact[key] = contact;
+    }
+  }
+  if (drivers == 0 && (b.resting || b.body.energy() < b.energyFloor)) {
+    if (!b.resting) {  // gone quiet: at rest, exactly, until a key drives it
+      b.body.reset();
+      std::fill(b.excluded.begin(), b.excluded.end(), -1);
+      std::fill(b.contact.begin(), b.contact.end(), -1.0);
+    }
+    b.resting = true;
+    return;
+  }
+  b.resting = false;
+  for (size_t i = 0; i < left.size(); ++i) {
+    for (int d = 0; d < drivers; ++d) b.forces[b.drivers[d]] = b.driving[d][i];
+    b.body.step(b.forces);
+    double l, r;
+    b.body.output(l, r);
+    left[i] += static_cast<float>(b.gain * l);
+    right[i] += static_cast<float>(b.gain * r);
   }
 }
 

@@ -8,6 +8,7 @@
 #include <span>
 #include <vector>
 
+#include "instruments/piano_body.h"
 #include "midi/midi_message.h"
 #include "synth/instrument.h"
 #include "synth/key_voice.h"
@@ -116,6 +117,21 @@ class Synth {
     KeyVoice* voice;
     double gain;  // its instrument's
   };
+  // An instrument's body (BodyPatch), stepped after its keys, sample by sample, on this thread:
+  // the keys' bridges drive it, every key not sounding as a voice rings in it in sympathy (its
+  // damper lifted while the key is held, caught by the sostenuto or the pedal is down).
+  struct Body {
+    PianoBody body;
+    std::vector<double> forces;         // per key, this sample, N
+    std::vector<int> drivers;           // the keys sounding as voices this piece, in order …
+    std::vector<const float*> driving;  // … and their board forces
+    std::vector<signed char> excluded;  // per key, as last told (−1: not yet)
+    std::vector<double> contact;        // per key, as last told
+    double gain = 1.0;                  // body.gain times the instrument's
+    double energyFloor = 0.0;           // J: below it, undriven, the body rests (not stepped)
+    bool resting = true;
+  };
+  void renderBody(size_t program, std::span<float> left, std::span<float> right) noexcept;
 
   std::vector<Instrument> instruments_;
   std::vector<std::vector<KeyVoice>> voices_;  // [instrument][note − lowest]
@@ -124,6 +140,7 @@ class Synth {
   // The keys a piece renders, in (instrument, note) order; room for every key.
   std::vector<BusyKey> busy_;
   std::unique_ptr<WorkerPool> pool_;  // renders busy_ (a pointer: the pool's threads stay put)
+  std::vector<std::unique_ptr<Body>> bodies_;  // per instrument; null without a body
   MasterBus master_;
   int maxBlock_ = 0;
   int program_ = 0, polyphonyOverride_ = 0;

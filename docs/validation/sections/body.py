@@ -1,0 +1,172 @@
+"""The piano's body: unison strings on the bridge decaying in two stages (Weinreich), a single
+string's bridge loss against the single-string T60 it was set from (docs/instrument-data.md §3.2),
+and the sustain pedal's sympathetic ring through the soundboard, absent from the dry piano.
+Rendered with hamiltone-render (--notes, and a small MIDI file for the pedal)."""
+import os
+import struct
+import tomllib
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from common import code, read_wav
+
+TITLE = "The body: bridge, two-stage decay and sympathetic resonance"
+FIGURES = ["body_two_stage_decay", "body_sympathetic_spectrum"]
+
+C4 = 440.0 * 2 ** ((60 - 69) / 12)
+
+
+def render(ctx, name, preset, source, seconds, extra=()):
+    path = ctx.path(name + ".wav")
+    args = [ctx.render, "--preset", ctx.source + "/presets/" + preset + ".toml", *source,
+            "--tail", 0 if source[0] == "--notes" else seconds, *extra, "--format", "pcm24",
+            "--quiet", "-o", path]
+    ctx.run(args)
+    x, rate = read_wav(path)
+    return (x[:, 0] if x.ndim == 2 else x), rate
+
+
+def levels(x, rate, hz, window=0.1):
+    """The partial at `hz` in dB, one value per `window` seconds (a single DFT bin)."""
+    n = int(window * rate)
+    phase = np.exp(-2j * np.pi * hz * np.arange(n) / rate)
+    return np.array([20 * np.log10(2 * abs(np.sum(x[i:i + n] * phase)) / n + 1e-12)
+                     for i in range(0, len(x) - n + 1, n)])
+
+
+def slope(db, t0, t1, smooth=0, window=0.1):
+    """dB/s lost from t0 to t1: the least-squares slope of the levels, each window's power first
+    averaged over ±smooth/2 s (the unisons beat in the aftersound)."""
+    power = 10 ** (db / 10)
+    half = int(round(smooth / window / 2))
+    idx = np.arange(int(round(t0 / window)), int(round(t1 / window)) + 1)
+    y = [10 * np.log10(np.mean(power[max(0, i - half):i + half + 1])) for i in idx]
+    return -np.polyfit(idx * window, y, 1)[0]
+
+
+def midi_file(path, pedal, seconds):
+    """Format 0, 480 ticks a beat at 120 bpm (1 ms a tick ≈ 1.04): the pedal down at 0 (or not),
+    C4 struck at 10 ms and held to the end."""
+    ticks = lambda s: int(round(s * 960))
+    def var(n):
+        out = [n & 0x7F]
+        while n > 0x7F:
+            n >>= 7
+            out.insert(0, (n & 0x7F) | 0x80)
+        return bytes(out)
+    events = b""
+    if pedal:
+        events += var(0) + bytes([0xB0, 64, 127])
+    events += var(ticks(0.01)) + bytes([0x90, 60, 100])
+    events += var(ticks(seconds) - ticks(0.01)) + bytes([0x80, 60, 0])
+    events += var(0) + b"\xff\x2f\x00"
+    with open(path, "wb") as f:
+        f.write(b"MThd" + struct.pack(">IHHH", 6, 0, 1, 480))
+        f.write(b"MTrk" + struct.pack(">I", len(events)) + events)
+
+
+def run(ctx):
+    seconds = 7.0  # the aftersound needs a few of its beats
+    with open(os.path.join(ctx.source, "presets/grand-piano-strings.toml"), "rb") as f:
+        t60 = next(k for k in tomllib.load(f)["key"] if k["note"] == "C4")["loss"]["t60_low_s"]
+    published = 60.0 / t60  # dB/s of one string, the STK column of data §3.2
+
+    notes = ["--notes", f"C4:100:{seconds}"]
+    body, rate = render(ctx, "body_c4", "grand-piano", notes, seconds)
+    one, _ = render(ctx, "body_c4_one", "grand-piano", notes, seconds,
+                    ["--set", "string.unisons=1"])
+    dry, _ = render(ctx, "body_c4_dry", "grand-piano-strings", notes, seconds)
+    db = {name: levels(x, rate, C4) for name, x in
+          (("three strings on the bridge (grand-piano)", body),
+           ("one string on the bridge", one),
+           ("three strings, rigid ends (grand-piano-strings)", dry))}
+    three, single, rigid = db.values()
+    end = seconds - 0.5
+    prompt, after = slope(three, 0.1, 0.9), slope(three, 2.5, end, smooth=1.0)
+    alone = slope(single, 0.5, end)
+    rigid_rate = slope(rigid, 0.5, end, smooth=1.0)
+
+    fig, ax = plt.subplots(figsize=(7, 3.5))
+    for name, d in db.items():
+        ax.plot(np.arange(len(d)) * 0.1, d - d[:3].max(), label=name)
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel("C4's fundamental (dB)")
+    ax.set_ylim(-90, 5)
+    ax.legend(fontsize=8)
+    out = [
+        "**Claim.** A key's unison strings on a common resistive bridge decay in two stages: while "
+        "they move in phase they drain n times faster than one string alone (the prompt sound), "
+        "then what the detune and the hammer's unequal shares put out of phase barely moves the "
+        "bridge and decays far more slowly (the aftersound) [Weinreich 1977]. The bridge's "
+        "resistance is set per key so that one string alone decays in the single-string T60 of "
+        "docs/instrument-data.md §3.2; the string's own loss is RT-425's string-only law (§2.1).",
+        "",
+        ctx.figure(fig, "body_two_stage_decay",
+                   "C4 at velocity 100, held: its fundamental's level in 100 ms windows."),
+        "| C4's fundamental | decay (dB/s) |",
+        "|---|---|",
+        f"| one string alone, on the bridge | {alone:.1f} |",
+        f"| published single-string decay (§3.2, STK: T60 = {t60:g} s) | {published:.1f} |",
+        f"| three strings on the bridge: prompt, 0.1–0.9 s | {prompt:.1f} |",
+        f"| three strings on the bridge: aftersound, 2.5–{end:g} s (1 s power means) | {after:.1f} |",
+        f"| three strings on rigid ends (grand-piano-strings), 0.5–{end:g} s | {rigid_rate:.1f} |",
+        "",
+        ctx.check(abs(alone - published) <= 0.2 * published,
+                  "one string on the bridge decays within 20 % of the published single-string rate"),
+        ctx.check(prompt > 2 * alone and after < 0.5 * alone,
+                  "prompt sound over twice, aftersound under half the single string's rate"),
+        "",
+        code(ctx.commands[-3]),
+        "",
+    ]
+
+    takes = {}
+    for pedal in (False, True):
+        midi = ctx.path(f"body_pedal_{int(pedal)}.mid")
+        midi_file(midi, pedal, seconds)
+        for preset in ("grand-piano", "grand-piano-strings"):
+            takes[(preset, pedal)], _ = render(ctx, f"body_{preset}_{int(pedal)}", preset,
+                                               ["--midi", midi], 0.0)
+    start, stop = int(0.5 * rate), int((seconds - 0.2) * rate)
+    def power_db(x):
+        return 10 * np.log10(np.mean(x[start:stop] ** 2) + 1e-30)
+    held = takes[("grand-piano", False)]
+    ring = takes[("grand-piano", True)] - held
+    dry_diff = np.max(np.abs(takes[("grand-piano-strings", True)] -
+                             takes[("grand-piano-strings", False)]))
+    change = power_db(ring) - power_db(held)
+
+    seg = slice(start, stop)
+    w = np.hanning(stop - start)
+    f = np.fft.rfftfreq(stop - start, 1 / rate)
+    spec = lambda x: 20 * np.log10(np.abs(np.fft.rfft(x[seg] * w)) / np.sum(w) * 2 + 1e-12)
+    fig, ax = plt.subplots(figsize=(7, 3.5))
+    ax.plot(f, spec(held), lw=0.7, label="C4 held, pedal up")
+    ax.plot(f, spec(takes[("grand-piano", True)]), lw=0.7, label="C4 held, pedal down")
+    ax.plot(f, spec(ring), lw=0.7, label="the difference: the sympathetic ring")
+    ax.set_xlim(50, 2000)
+    ax.set_ylim(-140, -20)
+    ax.set_xlabel("frequency (Hz)")
+    ax.set_ylabel("level (dBFS)")
+    ax.legend(fontsize=8)
+    strongest = f[np.argmax(np.where(f > 50, spec(ring), -np.inf))]
+    out += [
+        "**Claim.** With the sustain pedal down every key's strings ring in sympathy through the "
+        "soundboard (engine/instruments/piano_body.h); on the dry piano the pedal changes nothing "
+        "while the struck key is held (its damper is off either way).",
+        "",
+        ctx.figure(fig, "body_sympathetic_spectrum",
+                   f"C4 held, 0.5–{seconds - 0.2:g} s: spectra with the pedal up and down."),
+        f"**Measured.** Pedal down against pedal up, C4 held: the difference is {change:+.1f} dB "
+        f"of the held note's power, strongest at {strongest:.0f} Hz (C4's fundamental, where the "
+        "lifted C3, C2 … strings' partials meet it); on grand-piano-strings the largest sample "
+        f"difference is {dry_diff:g}. The ring is louder than a real piano's: this modal board is "
+        "a plain rectangle without the bridge's own mass and stiffness, so at a key's point it "
+        "gives more than a real bridge does, and each key's unisons ring as one.",
+        ctx.check(dry_diff == 0.0, "the dry piano is unchanged by the pedal"),
+        ctx.check(change > -40.0, "the pedal's sympathetic ring is there on grand-piano"),
+        "",
+        code(ctx.commands[-1]),
+    ]
+    return "\n".join(out)

@@ -1,0 +1,52 @@
+// A string instrument's body: the board and its sympathetic strings from the instrument's keys.
+#include "synth/instrument_body.h"
+
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+#include "instruments/piano_scale.h"
+
+namespace hamiltone {
+
+std::vector<SympatheticKey> sympatheticKeys(const Instrument& instrument) {
+  std::vector<SympatheticKey> keys;
+  for (int note = instrument.lowestNote; note <= instrument.highestNote; ++note) {
+    const StringKey& key = instrument.keys[note - instrument.lowestNote];
+    const StringPhysics& s = key.patch.string;
+    keys.push_back({.f0 = equalTemperament(note, key.patch.a4Hz),
+                    .inharmonicityB = std::numbers::pi * std::numbers::pi * s.young * s.inertia /
+                                      (s.tension * s.length * s.length),
+                    .linearDensity = s.linearDensity(),
+                    .length = s.length,
+                    .tension = s.tension,
+                    .unisons = key.unisons,
+                    .t60Low = key.patch.t60Low,
+                    .t60High = key.patch.t60High,
+                    .t60HighHz = key.patch.t60HighHz,
+                    .damperT60 = key.patch.damperT60});
+  }
+  return keys;
+}
+
+void prepareBody(PianoBody& body, const Instrument& instrument, double sampleRate) {
+  bool bridged = false;
+  for (const StringKey& key : instrument.keys) bridged = bridged || key.bridge.mass > 0.0;
+  if (!bridged)
+    throw std::invalid_argument(
+        "body.enabled = true: no key has a bridge to drive the soundboard (set bridge.mass_kg > "
+        "0)");
+  PianoBodySpec spec;
+  spec.board.maxModeHz = instrument.body.maxModeHz;
+  spec.sampleRate = sampleRate;
+  spec.sympatheticMaxHz = std::min(instrument.body.sympatheticMaxHz, 0.24 * sampleRate);
+  const std::vector<BoardPoint> points =
+      bridgeLine(instrument.lowestNote, instrument.highestNote, spec.board);
+  // Damped keys whose strings have gone quiet sleep out of the coupling (PianoBody): their springs
+  // leave the board. Keeping them all in (setQuietFloor(-1)) changed the pedal's effect at C4
+  // from +9.0 to +9.4 dB and cost three times as much with the pedal up (tests/synth/
+  // synth_body_test.cpp), so they sleep.
+  body.prepare(spec, points, sympatheticKeys(instrument));
+}
+
+}  // namespace hamiltone
