@@ -64,6 +64,9 @@ class KeyVoice {
   // Held when the sostenuto pedal (CC66) went down: its damper stays off the strings, whatever
   // the sustain pedal does, until the sostenuto pedal lifts.
   bool caught = false;
+  // Its damper's T60 as a multiple of the preset's, from its last note-off's release velocity
+  // (Synth::releaseScale): kept while the pedal moves that damper.
+  double releaseScale = 1.0;
 
  private:
   void render(size_t offset, size_t frames, double gain) noexcept;  // into the outputs there

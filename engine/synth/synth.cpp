@@ -67,7 +67,7 @@ void Synth::prepare(std::vector<Instrument> instruments, const SynthSetup& setup
     body->forces.assign(count, 0.0);
     body->driving.assign(count, nullptr);
     body->drivers.assign(count, 0);
-    body->excluded.assign(count, -1);
+    body->struck.assign(count, 0);
     body->contact.assign(count, -1.0);
     body->gain = instrument.body.gain * gains[p];
     // A hundredth of the quiet floor at the output: ½ m v² of one mode at that pickup speed.
@@ -195,21 +195,28 @@ void Synth::noteOn(int note, int velocity) noexcept {
   downProgram_[note] = program_;
 }
 
-void Synth::noteOff(int note) noexcept {
+double Synth::releaseScale(int velocity) noexcept {
+  if (velocity <= 0) return 1.0;  // none given (a note-on at velocity 0, or a keyboard's 0)
+  return std::exp2((64.0 - std::min(velocity, 127)) / 63.0);
+}
+
+void Synth::noteOff(int note, int velocity) noexcept {
   if (downProgram_[note] < 0) return;
   KeyVoice* voice = keyVoice(downProgram_[note], note);
   downProgram_[note] = -1;
   if (!voice || !voice->down) return;
   voice->down = false;
+  voice->releaseScale = releaseScale(velocity);
+  const double damperScale = damperScale_ * voice->releaseScale;
   if (voice->caught) {  // the sostenuto pedal holds its damper up
     voice->sustained = contact_ < 1.0;
     return;
   }
   if (contact_ < 1.0) {
     voice->sustained = true;
-    if (contact_ > 0.0) voice->release(damperScale_, contact_);  // a half pedal
+    if (contact_ > 0.0) voice->release(damperScale, contact_);  // a half pedal
   } else {
-    voice->release(damperScale_);
+    voice->release(damperScale);
   }
 }
 
@@ -227,10 +234,10 @@ void Synth::setSustain(int value) noexcept {
       if (v.caught) {  // its damper is the sostenuto's until that lifts
         v.sustained = contact < 1.0;
       } else if (contact < 1.0) {
-        v.release(damperScale_, contact);
+        v.release(damperScale_ * v.releaseScale, contact);
       } else {
         v.sustained = false;
-        v.release(damperScale_);
+        v.release(damperScale_ * v.releaseScale);
       }
     }
 }
@@ -250,9 +257,9 @@ void Synth::setSostenuto(bool down) noexcept {
       v.caught = false;
       if (v.down) continue;
       if (!v.sustained)
-        v.release(damperScale_);
+        v.release(damperScale_ * v.releaseScale);
       else if (contact_ > 0.0)
-        v.release(damperScale_, contact_);
+        v.release(damperScale_ * v.releaseScale, contact_);
     }
 }
 
@@ -278,7 +285,7 @@ void Synth::handle(const MidiMessage& m) noexcept {
       }
       [[fallthrough]];
     case midi::noteOff:
-      noteOff(m.data1 & 0x7F);
+      noteOff(m.data1 & 0x7F, m.kind() == midi::noteOff ? m.data2 & 0x7F : 0);
       break;
     case midi::controller:
       switch (m.data1) {
@@ -325,9 +332,18 @@ void Synth::handle(const MidiMessage& m) noexcept {
 
 void Synth::render(std::span<float> left, std::span<float> right) noexcept {
   int count = 0;
-  for (size_t p = 0; p < voices_.size(); ++p)
-    for (KeyVoice& v : voices_[p])
-      if (v.busy()) busy_[count++] = {&v, gains_[p]};
+  for (size_t p = 0; p < voices_.size(); ++p) {
+    Body* body = bodies_[p].get();
+    if (body) body->driverCount = 0;
+    for (size_t key = 0; key < voices_[p].size(); ++key) {
+      KeyVoice& v = voices_[p][key];
+      if (!v.busy()) continue;
+      busy_[count++] = {&v, gains_[p]};
+      // The keys rendered in this piece drive the body over all of it (one may fall silent and
+      // free itself inside it: its force is zero from then on).
+      if (body) body->drivers[body->driverCount++] = static_cast<int>(key);
+    }
+  }
   auto renderKey = [this, frames = left.size()](int k) noexcept {
     busy_[k].voice->process(frames, busy_[k].gain);
   };
@@ -346,46 +362,63 @@ void Synth::render(std::span<float> left, std::span<float> right) noexcept {
     if (bodies_[p]) renderBody(p, left, right);
 }
 
-// The body after the keys: who sounds as a voice (its sympathetic strings leave the coupling, its
-// bridge drives the board instead), whose damper is off, then the board sample by sample.
+// The body after the keys. What it does never depends on how the audio is cut into pieces: a key
+// leaves the sympathetic coupling when it is struck (an event, at its sample) and comes back when
+// the body rests; the dampers move at events; and the body goes to rest — exactly zero, so that
+// stepping it or not is the same — only at multiples of kBodyRestCheck samples, once undriven and
+// quiet for that long.
 void Synth::renderBody(size_t program, std::span<float> left, std::span<float> right) noexcept {
   Body& b = *bodies_[program];
-  int drivers = 0;
+  const int drivers = b.driverCount;
+  for (int d = 0; d < drivers; ++d) {
+    const int key = b.drivers[d];
+    const KeyVoice& v = voices_[program][key];
+    b.driving[d] = v.boardForce().data();
+    if (v.order() != b.struck[key]) {  // struck since: its strings are the voice's now
+      b.struck[key] = v.order();
+      b.body.setExcluded(key, true);
+    }
+  }
   for (size_t key = 0; key < b.forces.size(); ++key) {
     const KeyVoice& v = voices_[program][key];
-    const bool voiced = hasVoice_[program][key] && v.busy();
-    if (voiced) {
-      b.drivers[drivers] = static_cast<int>(key);
-      b.driving[drivers++] = v.boardForce().data();
-    }
-    b.forces[key] = 0.0;
-    if (static_cast<signed char>(voiced) != b.excluded[key]) {
-      b.body.setExcluded(static_cast<int>(key), voiced);
-      b.excluded[key] = voiced;
-    }
+    const int k = static_cast<int>(key);
     const double contact = (v.down || v.caught) ? 0.0 : contact_;  // the pedal lifts every damper
     if (contact != b.contact[key]) {
-      b.body.setDamper(static_cast<int>(key), contact);
+      b.body.setDamper(k, contact);
       b.contact[key] = contact;
     }
   }
-  if (drivers == 0 && (b.resting || b.body.energy() < b.energyFloor)) {
-    if (!b.resting) {  // gone quiet: at rest, exactly, until a key drives it
-      b.body.reset();
-      std::fill(b.excluded.begin(), b.excluded.end(), -1);
-      std::fill(b.contact.begin(), b.contact.end(), -1.0);
-    }
-    b.resting = true;
+  if (b.resting && drivers == 0) {
+    b.clock += static_cast<long>(left.size());
     return;
   }
-  b.resting = false;
   for (size_t i = 0; i < left.size(); ++i) {
-    for (int d = 0; d < drivers; ++d) b.forces[b.drivers[d]] = b.driving[d][i];
+    bool pushed = false;
+    for (int d = 0; d < drivers; ++d) {
+      const double f = b.driving[d][i];
+      b.forces[b.drivers[d]] = f;
+      pushed = pushed || f != 0.0;
+    }
+    if (pushed) {
+      b.resting = false;
+      b.lastPush = b.clock;
+    }
+    ++b.clock;
+    if (b.resting) continue;
     b.body.step(b.forces);
     double l, r;
     b.body.output(l, r);
     left[i] += static_cast<float>(b.gain * l);
     right[i] += static_cast<float>(b.gain * r);
+    if (b.clock % kBodyRestCheck == 0 && b.clock - b.lastPush >= kBodyRestCheck &&
+        b.body.energy() < b.energyFloor) {
+      b.body.reset();  // at rest, exactly; every key's strings back on the board
+      for (size_t key = 0; key < b.forces.size(); ++key) {
+        b.body.setExcluded(static_cast<int>(key), false);
+        b.forces[key] = 0.0;
+      }
+      b.resting = true;
+    }
   }
 }
 

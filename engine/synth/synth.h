@@ -39,7 +39,8 @@ struct SynthSetup {
 };
 
 // MIDI, omni (every channel plays the current instrument):
-//   note on/off (velocity 0 is a note-off); a note-on for a sounding key re-strikes that key's
+//   note on/off (velocity 0 is a note-off; a note-off's velocity sets how fast the damper acts,
+//   releaseScale()); a note-on for a sounding key re-strikes that key's
 //   voice (its strings keep vibrating, as on a piano); CC64 sustain, continuous (half-pedalling,
 //   damperContact()): the dampers of the keys released while it is down touch their strings with
 //   the pedal's contact, from fully on (0…20, as with no pedal) to fully lifted (100…127), and
@@ -79,6 +80,10 @@ class Synth {
   // felt's pressure on the string, and with it the loss it adds, grows with the way it is pressed
   // in. So 0 and 127 are today's up and down to the bit, and 64 is a half pedal (contact 0.45).
   static double damperContact(int value) noexcept;
+  // How a note-off's release velocity scales its damper's T60: 2^((64 − v)/63) — a key let go
+  // fast (127) damps in half the time, a slow one (1) in twice, 64 as the preset says; 0 (no
+  // velocity given, or a note-on at velocity 0) is 1.
+  static double releaseScale(int velocity) noexcept;
   int polyphony() const;
   int activeVoices() const;
   // No key sounds, fades out or waits to be struck: what comes out now is the master bus's
@@ -105,7 +110,7 @@ class Synth {
  private:
   void render(std::span<float> left, std::span<float> right) noexcept;
   void noteOn(int note, int velocity) noexcept;
-  void noteOff(int note) noexcept;
+  void noteOff(int note, int velocity = 0) noexcept;
   void setSustain(int value) noexcept;    // CC64
   void setSostenuto(bool down) noexcept;  // CC66
   void setBend(double fraction) noexcept;
@@ -122,15 +127,18 @@ class Synth {
   // damper lifted while the key is held, caught by the sostenuto or the pedal is down).
   struct Body {
     PianoBody body;
-    std::vector<double> forces;         // per key, this sample, N
-    std::vector<int> drivers;           // the keys sounding as voices this piece, in order …
+    std::vector<double> forces;  // per key, this sample, N
+    std::vector<int> drivers;    // the keys rendered this piece (driverCount), in order …
+    int driverCount = 0;
     std::vector<const float*> driving;  // … and their board forces
-    std::vector<signed char> excluded;  // per key, as last told (−1: not yet)
-    std::vector<double> contact;        // per key, as last told
+    std::vector<long> struck;           // per key, the strike (KeyVoice::order) it last saw
+    std::vector<double> contact;        // per key, as last told (−1: not yet)
     double gain = 1.0;                  // body.gain times the instrument's
     double energyFloor = 0.0;           // J: below it, undriven, the body rests (not stepped)
+    long clock = 0, lastPush = 0;       // samples since prepare(); the last with a force
     bool resting = true;
   };
+  static constexpr long kBodyRestCheck = 4096;  // samples between the body's rest checks
   void renderBody(size_t program, std::span<float> left, std::span<float> right) noexcept;
 
   std::vector<Instrument> instruments_;

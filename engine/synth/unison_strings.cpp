@@ -161,7 +161,8 @@ void UnisonStrings::processBridged(std::span<float> left, std::span<float> right
     reset();
     return;
   }
-  if (quiet_.update(left, right, n)) active_ = false;
+  // The board's force falls silent with the sound, at the same sample whatever the block size.
+  if (quiet_.update(left, right, n, std::span(boardForce_).first(n))) active_ = false;
 }
 
 }  // namespace hamiltone

@@ -61,9 +61,11 @@ class QuietDetector {
   void setFloor(double floor) noexcept { floor_ = floor; }
   // A strike starts a new note: its loudest is measured from here.
   void strike() noexcept { quietSamples_ = 0, loudest_ = envelope_; }
-  // Call after each block with its samples: fades them if the voice is going quiet. Returns true
-  // when the voice is now free.
-  bool update(std::span<float> left, std::span<float> right, size_t rightCount) noexcept {
+  // Call after each block with its samples: fades them (and `alongside`, when given: a signal that
+  // must fall silent with them, sample for sample) if the voice is going quiet. Returns true when
+  // the voice is now free.
+  bool update(std::span<float> left, std::span<float> right, size_t rightCount,
+              std::span<float> alongside = {}) noexcept {
     for (size_t i = 0; i < left.size(); ++i) {
       const double peak = std::max(std::abs(left[i]), i < rightCount ? std::abs(right[i]) : 0.0f);
       envelope_ = std::max(peak, envelope_ * decay_);
@@ -75,6 +77,7 @@ class QuietDetector {
           std::max(0.0, 1.0 - static_cast<double>(quietSamples_) / holdSamples_));
       left[i] *= gain;
       if (i < rightCount) right[i] *= gain;
+      if (i < alongside.size()) alongside[i] *= gain;
     }
     return quietSamples_ >= holdSamples_;
   }

@@ -133,7 +133,9 @@ TEST(ClapPlugin, PlaysInTuneAtEveryRateInBlocksOfAnySize) {
     EXPECT_EQ(difference, 0.0);
     EXPECT_GT(take.peak(0.05, 0.3), 0.05);
     EXPECT_NEAR(centsOff(take, 440.0, 0.3, 1.5), 0.0, 3.0);
-    EXPECT_LT(take.peak(2.55, 2.9), 1e-5);
+    // A second after the release: the damped strings are gone, the soundboard's lowest modes (39 Hz
+    // and up, T60 = 6.9/(πη f) ≈ 2.8 s there) still ring under −60 dB of the strike's peak.
+    EXPECT_LT(take.peak(2.55, 2.9), 2e-4);
   }
 }
 
@@ -154,8 +156,11 @@ TEST(ClapPlugin, ThePlayersControlsAreHeard) {
   const Take softer = level({param(0.0, kVelocityCurve, 2.0)}, 64);
   EXPECT_LT(softer.peak(0.05, 0.5), 0.8 * plain.peak(0.05, 0.5));
   const Take ringing = level({param(0.0, kDamperScale, 4.0)}, 64);
-  EXPECT_LT(plain.peak(1.45, 1.7), 1e-5);
-  EXPECT_GT(ringing.peak(1.45, 1.7), 3e-4 * ringing.peak(0.05, 0.5));  // −70 dB, over 30 of plain's
+  // Half a second after the release the plain note's damper has taken it 60 dB down and the
+  // soundboard's low modes (as above) are what remains; the long damper leaves the strings ringing
+  // far louder.
+  EXPECT_LT(plain.peak(1.45, 1.7), 2e-4);
+  EXPECT_GT(ringing.peak(1.0, 1.2), 5.0 * plain.peak(1.0, 1.2));  // 8.4 measured
 }
 
 // What a session saves comes back in another instance: the parameters, and the two strings — a
