@@ -70,9 +70,6 @@ void Synth::prepare(std::vector<Instrument> instruments, const SynthSetup& setup
     body->struck.assign(count, 0);
     body->contact.assign(count, -1.0);
     body->gain = instrument.body.gain * gains[p];
-    // A hundredth of the quiet floor at the output: ½ m v² of one mode at that pickup speed.
-    const double speed = 0.01 * QuietDetector::kFloor / std::max(std::abs(body->gain), 1e-30);
-    body->energyFloor = 0.5 * body->body.board().modalMass() * speed * speed;
     bodies[p] = std::move(body);
   }
   MasterBus master;
@@ -366,7 +363,7 @@ void Synth::render(std::span<float> left, std::span<float> right) noexcept {
 // leaves the sympathetic coupling when it is struck (an event, at its sample) and comes back when
 // the body rests; the dampers move at events; and the body goes to rest — exactly zero, so that
 // stepping it or not is the same — only at multiples of kBodyRestCheck samples, once undriven and
-// quiet for that long.
+// under the voices' quiet floor (−100 dBFS at the output) for that long.
 void Synth::renderBody(size_t program, std::span<float> left, std::span<float> right) noexcept {
   Body& b = *bodies_[program];
   const int drivers = b.driverCount;
@@ -410,8 +407,10 @@ void Synth::renderBody(size_t program, std::span<float> left, std::span<float> r
     b.body.output(l, r);
     left[i] += static_cast<float>(b.gain * l);
     right[i] += static_cast<float>(b.gain * r);
+    if (std::max(std::abs(b.gain * l), std::abs(b.gain * r)) > QuietDetector::kFloor)
+      b.lastLoud = b.clock;
     if (b.clock % kBodyRestCheck == 0 && b.clock - b.lastPush >= kBodyRestCheck &&
-        b.body.energy() < b.energyFloor) {
+        b.clock - b.lastLoud >= kBodyRestCheck) {
       b.body.reset();  // at rest, exactly; every key's strings back on the board
       for (size_t key = 0; key < b.forces.size(); ++key) {
         b.body.setExcluded(static_cast<int>(key), false);

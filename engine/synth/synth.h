@@ -134,8 +134,8 @@ class Synth {
     std::vector<long> struck;           // per key, the strike (KeyVoice::order) it last saw
     std::vector<double> contact;        // per key, as last told (−1: not yet)
     double gain = 1.0;                  // body.gain times the instrument's
-    double energyFloor = 0.0;           // J: below it, undriven, the body rests (not stepped)
-    long clock = 0, lastPush = 0;       // samples since prepare(); the last with a force
+    long clock = 0, lastPush = 0;       // samples since prepare(); the last with a force …
+    long lastLoud = 0;                  // … and the last the body was heard over the quiet floor
     bool resting = true;
   };
   static constexpr long kBodyRestCheck = 4096;  // samples between the body's rest checks
