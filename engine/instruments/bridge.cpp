@@ -9,20 +9,20 @@
 
 namespace hamiltone {
 
-BridgeCoupling::BridgeCoupling(const NonlinearString& string) : last_(string.transverseSize() - 1) {
+BridgeCoupling::BridgeCoupling(const NonlinearString& string)
+    : last_(string.transverseSize() - 1), second_(last_ > 0 ? last_ - 1 : last_) {
   const StringPhysics& p = string.physics();
   const double h = string.spacing();
   const double tension = string.tensionScale() * p.tension / h;  // βT0/h
   const double bending = p.young * p.inertia / (h * h * h);      // EI/h³
   c1_ = -(tension + 2.0 * bending);
-  c2_ = string.transverseSize() >= 2 ? bending : 0.0;  // one node: u_{M−2} is the fixed end
+  c2_ = last_ > 0 ? bending : 0.0;  // one node: u_{M−2} is the fixed end
   self_ = tension + bending;
 }
 
 double BridgeCoupling::energy(const Vector& q, const Vector& qNext, double w, double wNext) const {
-  const Eigen::Index second = last_ > 0 ? last_ - 1 : last_;
-  const double cq = c1_ * q[last_] + c2_ * q[second];
-  const double cqNext = c1_ * qNext[last_] + c2_ * qNext[second];
+  const double cq = c1_ * q[last_] + c2_ * q[second_];
+  const double cqNext = c1_ * qNext[last_] + c2_ * qNext[second_];
   return 0.5 * (cqNext * w + cq * wNext) + 0.5 * self_ * wNext * w;
 }
 

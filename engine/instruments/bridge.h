@@ -35,16 +35,19 @@ class BridgeCoupling {
   double forceOnLast(double w) const { return -c1_ * w; }    // on u_{M−1}
   double forceOnSecond(double w) const { return -c2_ * w; }  // on u_{M−2}
   Eigen::Index lastIndex() const { return last_; }
+  // u_{M−2}'s place; on a string of two segments (one node) u_{M−2} is the fixed end, c2 = 0, and
+  // this names u_{M−1} again, so that every use stays inside q.
+  Eigen::Index secondIndex() const { return second_; }
   // −∂E_c/∂w at level n: the string's pull on the bridge.
   double forceOnBridge(const Vector& q, double w) const {
-    return -(c1_ * q[last_] + c2_ * q[last_ - 1]) - self_ * w;
+    return -(c1_ * q[last_] + c2_ * q[second_]) - self_ * w;
   }
   // E_c^{n+½} from q^n, q^{n+1}, w^n, w^{n+1}.
   double energy(const Vector& q, const Vector& qNext, double w, double wNext) const;
   double selfStiffness() const { return self_; }
 
  private:
-  Eigen::Index last_ = 0;
+  Eigen::Index last_ = 0, second_ = 0;
   double c1_ = 0.0, c2_ = 0.0, self_ = 0.0;
 };
 

@@ -256,7 +256,7 @@ void StringVoice::wake() noexcept {
 
 bool StringVoice::stepOnBridge(double w, double out[2]) noexcept {
   scheme_->setPointForce(0, coupling_.lastIndex(), coupling_.forceOnLast(w));
-  scheme_->setPointForce(1, coupling_.lastIndex() - 1, coupling_.forceOnSecond(w));
+  scheme_->setPointForce(1, coupling_.secondIndex(), coupling_.forceOnSecond(w));
   if (!stepAndPick(out)) return false;
   out[0] *= patch_.gain;
   out[1] *= patch_.gain;

@@ -62,7 +62,7 @@ struct BridgedStrings {
     for (size_t s = 0; s < strings.size(); ++s) {
       const BridgeCoupling& c = couplings[s];
       strings[s].setPointForce(0, c.lastIndex(), c.forceOnLast(w));
-      strings[s].setPointForce(1, c.lastIndex() - 1, c.forceOnSecond(w));
+      strings[s].setPointForce(1, c.secondIndex(), c.forceOnSecond(w));
       strings[s].step();
       pull += c.forceOnBridge(strings[s].q(), w);
     }
