@@ -169,12 +169,12 @@ void SympatheticStrings::reset() noexcept {
 void SympatheticStrings::setCoefficients(int key) noexcept {
   const SympatheticKey& s = data_[key];
   const double c = contact_[key];
-  const double damper = std::isinf(s.damperT60) ? 0.0 : kLn1000 / s.damperT60;
+  // The damper adds c ln(1000)/damperT60 to the string's own decay rate, as it does to a voice's
+  // (releasedSigma0): a damper only ever takes energy away.
+  const double damper = std::isinf(s.damperT60) ? 0.0 : c * kLn1000 / s.damperT60;
   for (int n = 1; n <= partials_[key]; ++n) {
     const Eigen::Index j = slot(key, n);
-    // The damper blends the decay rate: (1 − c) σ_own + c σ_damper (T60 = damperT60 at c = 1).
-    const double sigma =
-        std::isinf(s.damperT60) ? sigmaOwn_[j] : (1.0 - c) * sigmaOwn_[j] + c * damper;
+    const double sigma = sigmaOwn_[j] + damper;
     sigma_[j] = sigma;
     const double damp = 1.0 + sigma * k_;  // (Y3) solved for a^{n+1}
     a1_[j] = (2.0 - stiffness_[j] * k_ * k_ / mass_[j]) / damp;

@@ -22,7 +22,7 @@ struct SympatheticKey {
   double t60Low = 8.0;   // s, at 0 Hz (docs/instrument-data.md §3.4); +inf: lossless
   double t60High = 2.0;  // s, at t60HighHz; +inf: lossless
   double t60HighHz = 2000.0;
-  double damperT60 = 0.5;  // s, the damper on; +inf: no damper
+  double damperT60 = 0.5;  // s, the damper's own decay, added to the string's; +inf: no damper
 };
 
 // The concert grand's keys lowestNote … highestNote (MIDI 21 … 108): the strings of pianoString()
@@ -60,7 +60,8 @@ class SympatheticStrings {
                double maxHz, int maxPartials = 16);
   void reset() noexcept;  // at rest, dampers as set, tallies zero
 
-  // 0: lifted (the string's own loss), 1: the damper on (its T60); between, σ blends linearly.
+  // 0: lifted (the string's own loss); 1: the damper on, adding ln(1000)/damperT60 to every
+  // partial's decay rate; between, `contact` times that.
   void setDamper(int key, double contact) noexcept;
   // An excluded key's strings leave the coupling (a voice plays them); it returns at rest on the
   // board, statically attached. w, wPrev: the key's w^{n+1}, w^n. The jump in H_strings + H_c is

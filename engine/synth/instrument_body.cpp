@@ -2,12 +2,17 @@
 #include "synth/instrument_body.h"
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 
 #include "instruments/piano_scale.h"
 
 namespace hamiltone {
+
+namespace {
+constexpr double kNoDamperT60 = 1000.0;  // s: loss.damper_t60_s's largest value, "no damper"
+}  // namespace
 
 std::vector<SympatheticKey> sympatheticKeys(const Instrument& instrument) {
   std::vector<SympatheticKey> keys;
@@ -24,7 +29,10 @@ std::vector<SympatheticKey> sympatheticKeys(const Instrument& instrument) {
                     .t60Low = key.patch.t60Low,
                     .t60High = key.patch.t60High,
                     .t60HighHz = key.patch.t60HighHz,
-                    .damperT60 = key.patch.damperT60});
+                    // The preset's 1000 s says "no damper" (F6 up): such a key never sleeps.
+                    .damperT60 = key.patch.damperT60 >= kNoDamperT60
+                                     ? std::numeric_limits<double>::infinity()
+                                     : key.patch.damperT60});
   }
   return keys;
 }
@@ -44,7 +52,7 @@ void prepareBody(PianoBody& body, const Instrument& instrument, double sampleRat
       bridgeLine(instrument.lowestNote, instrument.highestNote, spec.board);
   // Damped keys whose strings have gone quiet sleep out of the coupling (PianoBody): their springs
   // leave the board. Keeping them all in (setQuietFloor(-1)) changed the pedal's effect at C4
-  // from +9.0 to +9.4 dB and cost three times as much with the pedal up (tests/synth/
+  // by 0.4 dB and cost three times as much with the pedal up (tests/synth/
   // synth_body_test.cpp), so they sleep.
   body.prepare(spec, points, sympatheticKeys(instrument));
 }

@@ -661,10 +661,8 @@ TEST_F(JackPlay, SaysWhyTheVoiceLimitDropped) {
   if (!onPath("jackd") || !onPath("jack_lsp"))
     GTEST_SKIP() << "jackd (Debian's jackd2) is not installed";
   ASSERT_NO_FATAL_FAILURE(startServer(false));
-  // The dry piano: this is about the voice limit, and grand-piano's body, rung by a loud chord,
-  // stays over the quiet floor for longer than the test waits for the player to end.
   const std::optional<int> code =
-      playToTheEnd({"--preset", HAMILTONE_SOURCE_DIR "/presets/grand-piano-strings.toml", "--notes",
+      playToTheEnd({"--preset", HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml", "--notes",
                     "C4:100:0.5, E4:100:0.5, G4:100:0.5, C5:100:0.5, E5:100:0.5, G5:100:0.5",
                     "--cpu-limit", "0.001", "--threads", "1"});
   const std::string err = slurp(dir_ / "player.err");

@@ -287,6 +287,29 @@ TEST(SympatheticStrings, StringsRingInSympathyWithDampersLifted) {
   EXPECT_GE(neighbourDb, 20.0);
 }
 
+// A damper adds its rate to every partial's own, as a voice's does (releasedSigma0): contact c
+// adds c ln(1000)/damperT60 exactly, so it never lets a string ring longer than lifted — the
+// preset's "1000 s: no damper" once made the undamped treble ring at 0.06 dB/s with the pedal up.
+TEST(SympatheticStrings, ADamperOnlyAddsLoss) {
+  const auto keys = grandSympatheticKeys();
+  PianoBody body = preparedBody(keys);
+  for (int key = 0; key < body.keys(); ++key) {
+    std::vector<double> own;
+    body.setDamper(key, 0.0);
+    for (int n = 1; n <= body.strings().partials(key); ++n)
+      own.push_back(body.strings().partialDecayRate(key, n));
+    for (double c : {0.25, 1.0}) {
+      body.setDamper(key, c);
+      const double added =
+          std::isinf(keys[key].damperT60) ? 0.0 : c * 6.907755278982137 / keys[key].damperT60;
+      for (int n = 1; n <= body.strings().partials(key); ++n)
+        ASSERT_DOUBLE_EQ(body.strings().partialDecayRate(key, n), own[n - 1] + added)
+            << "key " << key << " partial " << n << " contact " << c;
+    }
+    EXPECT_EQ(body.strings().damped(key), !std::isinf(keys[key].damperT60)) << "key " << key;
+  }
+}
+
 TEST(SympatheticStrings, StabilityConditionIsChecked) {
   auto keys = grandSympatheticKeys();
   keys[87].tension = 1e9;  // a string as stiff as a wall on the bridge

@@ -18,6 +18,7 @@ namespace {
 
 using testing::cc;
 using testing::kTakeRate;
+using testing::off;
 using testing::on;
 
 // C4 struck at velocity 100 and held for `seconds`, the pedal down from the start or not.
@@ -86,11 +87,34 @@ TEST(SynthBody, ThePedalLetsTheOtherStringsRingInSympathy) {
       "with the pedal the output changes by %+.1f dB of the held note, %.0f %% of the "
       "change at C4's first eight partials (single bins)\n",
       relativeDb, 100.0 * atPartials / power);
-  // Measured +9.0 dB, nearly all at C4's fundamental: the lifted bass strings whose partials meet
+  // Measured +9.4 dB, nearly all at C4's fundamental: the lifted bass strings whose partials meet
   // it (C3's second, C2's fourth …) ring loud on this board — louder than on a real piano, whose
   // bridge is stiffer and heavier than this modal board at a point (docs/validation.md).
   EXPECT_GT(relativeDb, -40.0);
   EXPECT_GT(atPartials, 0.5 * power);
+}
+
+// A staccato C4 with the pedal up: its voice dies under its damper (T60 0.51 s) and the body,
+// undriven, rests once under the voices' quiet floor. What rings longest is the treble from F6 up,
+// which has no damper and answers C4's upper partials: −92 dBFS at the release, decaying at the
+// strings' own loss, at least 5.2 dB/s (F6's fundamental, RT-425), so it is under −100 dBFS within
+// 1.6 s, and the body rests at the next 4096-sample check. Measured: silent 1.1 s after the
+// release (8.5 s when a damper could lower a string's loss, docs: SympatheticStrings).
+TEST(SynthBody, AStaccatoNoteLeavesTheWholePianoSilentSoonAfter) {
+  Synth synth;
+  std::vector<bool> notes(128, false);
+  notes[60] = true;
+  synth.prepare({loadPreset(HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml")},
+                {.sampleRate = kTakeRate, .maxBlock = 256, .notes = notes, .threads = 1});
+  const double release = 1.0;
+  long silentAt = -1;
+  testing::render(synth, {{0.0, on(60, 100)}, {release, off(60)}}, 6.0, 256, [&](long frames) {
+    if (silentAt < 0 && synth.silent()) silentAt = frames;
+  });
+  ASSERT_GT(silentAt, 0) << "still sounding 5 s after the release";
+  const double after = static_cast<double>(silentAt) / kTakeRate - release;
+  std::printf("silent %.2f s after the release\n", after);
+  EXPECT_LT(after, 2.5);
 }
 
 }  // namespace
