@@ -70,6 +70,8 @@ void Synth::prepare(std::vector<Instrument> instruments, const SynthSetup& setup
     body->struck.assign(count, 0);
     body->contact.assign(count, -1.0);
     body->gain = instrument.body.gain * gains[p];
+    body->fadeSamples =
+        std::max(1, static_cast<int>(std::lround(KeyVoice::kFadeS * setup.sampleRate)));
     bodies[p] = std::move(body);
   }
   MasterBus master;
@@ -270,6 +272,8 @@ void Synth::setBend(double fraction) noexcept {
 void Synth::allSoundOff() noexcept {
   for (auto& keys : voices_)
     for (KeyVoice& v : keys) v.fadeOut();
+  for (auto& body : bodies_)
+    if (body && !body->resting && body->fadeLeft == 0) body->fadeLeft = body->fadeSamples;
   std::fill(std::begin(downProgram_), std::end(downProgram_), -1);
 }
 
@@ -363,7 +367,8 @@ void Synth::render(std::span<float> left, std::span<float> right) noexcept {
 // leaves the sympathetic coupling when it is struck (an event, at its sample) and comes back when
 // the body rests; the dampers move at events; and the body goes to rest — exactly zero, so that
 // stepping it or not is the same — only at multiples of kBodyRestCheck samples, once undriven and
-// under the voices' quiet floor (−100 dBFS at the output) for that long.
+// under the voices' quiet floor (−100 dBFS at the output) for that long — or at once when the
+// 5 ms fade of a CC120 ends, which is an event's sample plus a fixed count.
 void Synth::renderBody(size_t program, std::span<float> left, std::span<float> right) noexcept {
   Body& b = *bodies_[program];
   const int drivers = b.driverCount;
@@ -405,20 +410,32 @@ void Synth::renderBody(size_t program, std::span<float> left, std::span<float> r
     b.body.step(b.forces);
     double l, r;
     b.body.output(l, r);
-    left[i] += static_cast<float>(b.gain * l);
-    right[i] += static_cast<float>(b.gain * r);
+    // Linear to zero, as a voice fades (KeyVoice::render).
+    double gain = b.gain;
+    bool silenced = false;
+    if (b.fadeLeft > 0) {
+      gain *= static_cast<double>(--b.fadeLeft) / b.fadeSamples;
+      silenced = b.fadeLeft == 0;
+    }
+    left[i] += static_cast<float>(gain * l);
+    right[i] += static_cast<float>(gain * r);
     if (std::max(std::abs(b.gain * l), std::abs(b.gain * r)) > QuietDetector::kFloor)
       b.lastLoud = b.clock;
-    if (b.clock % kBodyRestCheck == 0 && b.clock - b.lastPush >= kBodyRestCheck &&
-        b.clock - b.lastLoud >= kBodyRestCheck) {
-      b.body.reset();  // at rest, exactly; every key's strings back on the board
-      for (size_t key = 0; key < b.forces.size(); ++key) {
-        b.body.setExcluded(static_cast<int>(key), false);
-        b.forces[key] = 0.0;
-      }
-      b.resting = true;
-    }
+    if (silenced || (b.clock % kBodyRestCheck == 0 && b.clock - b.lastPush >= kBodyRestCheck &&
+                     b.clock - b.lastLoud >= kBodyRestCheck))
+      rest(b);
   }
+}
+
+// At rest, exactly; every key's strings back on the board.
+void Synth::rest(Body& b) noexcept {
+  b.body.reset();
+  for (size_t key = 0; key < b.forces.size(); ++key) {
+    b.body.setExcluded(static_cast<int>(key), false);
+    b.forces[key] = 0.0;
+  }
+  b.fadeLeft = 0;
+  b.resting = true;
 }
 
 void Synth::process(std::span<float> left, std::span<float> right,

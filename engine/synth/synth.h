@@ -136,10 +136,12 @@ class Synth {
     double gain = 1.0;                  // body.gain times the instrument's
     long clock = 0, lastPush = 0;       // samples since prepare(); the last with a force …
     long lastLoud = 0;                  // … and the last the body was heard over the quiet floor
+    int fadeSamples = 1, fadeLeft = 0;  // silenced (CC120): fades like a voice, then rests
     bool resting = true;
   };
   static constexpr long kBodyRestCheck = 4096;  // samples between the body's rest checks
   void renderBody(size_t program, std::span<float> left, std::span<float> right) noexcept;
+  static void rest(Body& b) noexcept;
 
   std::vector<Instrument> instruments_;
   std::vector<std::vector<KeyVoice>> voices_;  // [instrument][note − lowest]

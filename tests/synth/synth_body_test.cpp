@@ -117,5 +117,53 @@ TEST(SynthBody, AStaccatoNoteLeavesTheWholePianoSilentSoonAfter) {
   EXPECT_LT(after, 2.5);
 }
 
+// CC120 (all sound off) silences the body with the voices: a pedalled chord rings on the board
+// and in the lifted strings; 5 ms after the message (KeyVoice::kFadeS, the same linear fade) the
+// synthesizer is silent, and a quarter second on only the master's DC blocker (32 ms) still rings,
+// at 1e-3 of the chord's peak, as Synth.AllNotesOffReleasesHeldKeysAndAllSoundOffSilences asks of
+// the voices. A key struck afterwards rings again.
+TEST(SynthBody, AllSoundOffSilencesTheBodyToo) {
+  Synth synth;
+  std::vector<bool> notes(128, false);
+  for (int n : {48, 55, 60, 64}) notes[n] = true;
+  synth.prepare({loadPreset(HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml")},
+                {.sampleRate = kTakeRate, .maxBlock = 256, .notes = notes, .threads = 1});
+  const double silence = 0.5, again = 0.9;
+  bool silentBefore = true, silentAfter = false;
+  const testing::Take take = testing::render(synth,
+                                             {{0.0, cc(64, 127)},
+                                              {0.0, on(48, 120)},
+                                              {0.0, on(55, 120)},
+                                              {0.0, on(64, 120)},
+                                              {0.2, off(48)},
+                                              {0.2, off(55)},
+                                              {0.2, off(64)},
+                                              {silence, cc(120, 0)},
+                                              {again, on(60, 100)}},
+                                             1.1, 64, [&](long frames) {
+                                               const double t =
+                                                   static_cast<double>(frames) / kTakeRate;
+                                               if (t <= silence)
+                                                 silentBefore = silentBefore && synth.silent();
+                                               if (t >= silence + 0.006 && t < again)
+                                                 silentAfter = synth.silent();
+                                             });
+  EXPECT_FALSE(silentBefore);
+  EXPECT_TRUE(silentAfter);
+  auto peak = [&](double from, double to) {
+    float p = 0.0f;
+    for (size_t i = static_cast<size_t>(from * kTakeRate); i < static_cast<size_t>(to * kTakeRate);
+         ++i)
+      p = std::max({p, std::abs(take.left[i]), std::abs(take.right[i])});
+    return p;
+  };
+  const float chord = peak(0.0, silence), ringing = peak(silence - 0.05, silence);
+  const float after = peak(silence + 0.25, again);
+  std::printf("chord peak %.3g, ringing at the CC120 %.3g, a quarter second after %.3g\n", chord,
+              ringing, after);
+  EXPECT_LT(after, 1e-3f * chord);
+  EXPECT_GT(peak(again, 1.1), 1e-2f);
+}
+
 }  // namespace
 }  // namespace hamiltone
