@@ -63,7 +63,7 @@ class SavScheme {
   // Sherman–Morrison (33), then ψ^{n+½} by (38c). In the paper's naming the members hold
   // q^{n−1} = prev_, q^n = curr_, q^{n+1} = next_ during the step.
   void step() noexcept {
-    if (loss_.any() || forced_)
+    if (loss_.any() || forced_ || damped_)
       stepInternal<true>();
     else
       stepInternal<false>();
@@ -109,6 +109,21 @@ class SavScheme {
   void setPointForce(int slot, Eigen::Index i, double f) noexcept {
     pointIndex_[slot] = i;
     pointForce_[slot] = f;
+  }
+
+  // A dashpot of resistance r (kg/s) on coordinate i — a damper's felt pressing on the string
+  // there — acting through the next steps (slot 0 … kPointDampers−1; r = 0 lifts it). Centred:
+  //   M δtt q = … − r (q^{n+1} − q^{n−1})/(2k) e_i,                                      (D1)
+  // so the left matrix gains d = r k M⁻¹_ii / 2 at (i, i): still diagonal plus Σ α_j β_jᵀ, solved
+  // exactly by the same Woodbury with those few diagonal entries changed (stepInternal). Each step
+  // takes r/(4k) (q_i^{n+1} − q_i^{n−1})² >= 0 of the energy, tallied in dissipated(): the scheme
+  // stays dissipative and stable for any r >= 0.
+  static constexpr int kPointDampers = 8;
+  void setPointDamper(int slot, Eigen::Index i, double r) noexcept {
+    damperIndex_[slot] = i;
+    damperR_[slot] = r;
+    damped_ = false;
+    for (double x : damperR_) damped_ = damped_ || x > 0.0;
   }
 
   // Sets coordinate i at levels n and n+1 — a hammer placed and launched, or caught. The caller
@@ -255,6 +270,32 @@ class SavScheme {
         gb += bLinear[b] * h[b] * gMg[std::min(a, b) * parts + std::max(a, b)];
       vtb[a] = h[a] * gb;
     }
+    // The dampers (D1): D = (1+σ0k) I + Σ_m d_m e_m e_mᵀ, b' = b + Σ_m d_m q_m^{n−1} e_m. Woodbury
+    // with D: y = ((1+σ0k) I + W)⁻¹ z, W = (1+σ0k) Vᵀ D⁻¹ U, z = (1+σ0k) Vᵀ D⁻¹ b', and
+    // q^{n+1} = D⁻¹ (b' − U y) — the undamped coordinates as before, the damped ones below.
+    // bDamped_m: b'_m, b at the damped coordinate before U y.
+    double bDamped[kPointDampers] = {}, dDamped[kPointDampers] = {};
+    if (damped_) {
+      for (int m = 0; m < kPointDampers; ++m) {
+        const Eigen::Index i = damperIndex_[m];
+        const double d = 0.5 * damperR_[m] * k * minv[i];
+        dDamped[m] = d;
+        if (d == 0.0) continue;
+        double b = 2.0 * q[i] - down * qm[i] + d * qm[i];
+        if constexpr (splitK) b -= kk * (minv[i] * kq[i]);
+        if constexpr (lossy) b -= cqScale * minv[i] * cq[i];
+        for (int a = 0; a < parts; ++a) b += h[a] * minv[i] * g[a][i] * bLinear[a];
+        for (int p = 0; p < kPointForces; ++p)
+          if (pointIndex_[p] == i) b += kk * minv[i] * pointForce_[p];
+        bDamped[m] = b;
+        const double shrink = up / (up + d) - 1.0;  // (1+σ0k) D⁻¹ − I at i
+        for (int a = 0; a < parts; ++a) {
+          const double va = h[a] * g[a][i];  // β_a at i
+          vtb[a] += va * (d * qm[i] + shrink * b);
+          for (int c2 = 0; c2 < parts; ++c2) vtu(a, c2) += shrink * va * h[c2] * minv[i] * g[c2][i];
+        }
+      }
+    }
     const SmallVector y = (Small::Identity() * up + vtu).inverse() * vtb;
     double c[parts];  // the weights of M⁻¹∇V'_j in q^{n+1} (1+σ0k)
     for (int a = 0; a < parts; ++a) c[a] = h[a] * (bLinear[a] - y[a]);
@@ -287,8 +328,23 @@ class SavScheme {
       const double dx = kk * minv[i] * pointForce_[p] * invUp;
       qp[i] += dx;
       for (int a = 0; a < parts; ++a) gdq[a] += g[a][i] * dx;
-      supplied_ += 0.5 * pointForce_[p] * (qp[i] - qm[i]);
     }
+    // The damped coordinates: D⁻¹ (b' − U y) there, b' − U y = b'_m − Σ_j α_j y_j.
+    for (int m = 0; damped_ && m < kPointDampers; ++m) {
+      const double d = dDamped[m];
+      if (d == 0.0) continue;
+      const Eigen::Index i = damperIndex_[m];
+      double x = bDamped[m];
+      for (int a = 0; a < parts; ++a) x -= h[a] * minv[i] * g[a][i] * y[a];
+      x /= up + d;
+      const double dx = x - qp[i];
+      qp[i] = x;
+      for (int a = 0; a < parts; ++a) gdq[a] += g[a][i] * dx;
+      if (params_.trackDissipation)
+        dissipated_ += damperR_[m] / (4.0 * k) * (x - qm[i]) * (x - qm[i]);  // (D1)
+    }
+    for (int p = 0; p < kPointForces; ++p)
+      supplied_ += 0.5 * pointForce_[p] * (qp[pointIndex_[p]] - qm[pointIndex_[p]]);
     for (int a = 0; a < parts; ++a) psi_[a] += 0.5 * s[a] * gdq[a];  // (38c)
     if constexpr (lossy) {
       if (params_.trackDissipation)
@@ -347,6 +403,9 @@ class SavScheme {
   bool forced_ = false;
   std::array<Eigen::Index, kPointForces> pointIndex_{};
   std::array<double, kPointForces> pointForce_{};
+  std::array<Eigen::Index, kPointDampers> damperIndex_{};
+  std::array<double, kPointDampers> damperR_{};  // kg/s; 0: lifted
+  bool damped_ = false;
   double supplied_ = 0.0;  // work of f and of the point forces since the start
   double dissipated_ = 0.0;
   long n_ = 0;
