@@ -19,6 +19,8 @@ constexpr VoiceField kStringFields[] = {
     {"oversampling", "scheme.oversampling"},
     {"a4_hz", "a4_Hz"},
     {"damper_t60_s", "loss.damper_t60_s"},
+    {"damper_position", "damper.position"},
+    {"damper_width_m", "damper.width_m"},
     {"pickup_position", "pickups.left_position"},
     {"channels", "pickups.channels"},
     {"gain", "pickups.gain"},
@@ -57,6 +59,7 @@ void buildStringKeys(const PresetValues& values, Instrument& instrument) {
   instrument.bendRange = number("bend_range_semitones");
   StringPatch common;
   common.tuneBy = word("string.tune_by") == "tension" ? TuneBy::tension : TuneBy::length;
+  common.feltDamper = word("damper.model") == "felt";
   common.a4Hz = number("a4_Hz");
   const std::string rule = word("scheme.grid_rule");
   common.grid = rule == "two-grid"     ? GridRule::twoGrid
@@ -106,6 +109,8 @@ void buildStringKeys(const PresetValues& values, Instrument& instrument) {
     p.t60Low = at("loss.t60_low_s");
     p.t60High = at("loss.t60_high_s");
     p.damperT60 = at("loss.damper_t60_s");
+    p.damperPosition = at("damper.position");
+    p.damperWidth = at("damper.width_m");
     p.gain = at("pickups.gain");
     p.velocityMin = at("hammer.velocity_min_m_s");
     p.velocityMax = at("hammer.velocity_max_m_s");

@@ -3,6 +3,7 @@
 #include "voices/string_voice.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -151,10 +152,39 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
     if (round > 0 && need <= betaMax) break;
     betaMax = std::max(widest, need);
   }
-  require((loss.sigma0 + kLn1000 / patch.damperT60) * k < 1.0, "damper_t60_s", patch.damperT60,
+  require(patch.feltDamper || (loss.sigma0 + kLn1000 / patch.damperT60) * k < 1.0, "damper_t60_s",
+          patch.damperT60,
           "longer than ln(1000) k / (1 − σ0 k) = " +
               formatNumber(kLn1000 * k / (1.0 - loss.sigma0 * k)) + " s at this rate");
+  require(patch.damperPosition > 0.0 && patch.damperPosition < 1.0, "damper_position",
+          patch.damperPosition, "a fraction of the length in (0, 1)");
+  require(patch.damperWidth >= 0.0 && patch.damperWidth <= 0.1, "damper_width_m", patch.damperWidth,
+          "between 0 and 0.1 m");
   NonlinearString string(tuned.physics, tuned.grid);
+  // The nodes of u's grid under the felt (at least the nearest, at most kPointDampers spread
+  // evenly over it), and the resistance each needs for the fundamental to gain
+  // ln(1000)/damper_t60_s of decay rate:
+  //   r = σ ρA L / Σ_m sin²(π x_m/L)                                                   (D2)
+  const int segments = string.segments();
+  const double length = tuned.physics.length;
+  auto feltNode = [&](double x) {
+    return std::clamp<Eigen::Index>(std::lround(x / length * segments) - 1, 0, segments - 2);
+  };
+  const Eigen::Index first = feltNode(patch.damperPosition * length),
+                     last = feltNode(patch.damperPosition * length + patch.damperWidth);
+  constexpr int kMost = SplitSav<HammeredString>::kPointDampers;
+  const int feltNodes = static_cast<int>(std::min<Eigen::Index>(last - first + 1, kMost));
+  std::array<Eigen::Index, kMost> felt{};
+  double shape = 0.0;
+  for (int m = 0; m < feltNodes; ++m) {
+    felt[m] = feltNodes == 1 ? first : first + (last - first) * m / (feltNodes - 1);
+    shape += std::pow(std::sin(std::numbers::pi * (felt[m] + 1) / segments), 2);
+  }
+  // loss.damper_t60_s's largest value, 1000 s, says "no damper" (F6 up): no felt to step.
+  const double feltR =
+      patch.damperT60 >= 1000.0
+          ? 0.0
+          : kLn1000 / patch.damperT60 * tuned.physics.linearDensity() * length / shape;
   const double epsilon = gaugeShift(patch, string, k);
   string.setTensionRange(betaMax);
   const HammeredString system(std::move(string), patch.hammer);
@@ -173,6 +203,9 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
   patch_ = patch;
   sampleRate_ = sampleRate;
   k_ = k;
+  feltNode_ = felt;
+  feltNodes_ = feltR > 0.0 ? feltNodes : 0;
+  feltR_ = feltR;
   loss_ = loss;
   fundamental_ = schemePartial(system.string(), k, 1);
   bendOffset_ = system.string().transverseEigenvalue(1, 0.0);
@@ -240,7 +273,8 @@ void StringVoice::noteOn(double velocity) noexcept {
   scheme_->setCoordinate(w, start, start + speed * k_);
   scheme_->resetPsi(1);
   injected_ += energy() - before;
-  scheme_->setSigma0(loss_.sigma0);
+  scheme_->setSigma0(loss_.sigma0);  // the damper lifts
+  for (int m = 0; m < feltNodes_; ++m) scheme_->setPointDamper(m, feltNode_[m], 0.0);
   separatedSteps_ = 0;
   struck_ = parked_ = false;
   quiet_.strike();
@@ -264,7 +298,14 @@ bool StringVoice::stepOnBridge(double w, double out[2]) noexcept {
 }
 
 void StringVoice::release(double damperScale, double contact) noexcept {
-  scheme_->setSigma0(releasedSigma0(loss_.sigma0, patch_.damperT60, damperScale, k_, contact));
+  if (!patch_.feltDamper) {
+    scheme_->setSigma0(releasedSigma0(loss_.sigma0, patch_.damperT60, damperScale, k_, contact));
+    return;
+  }
+  // A NaN contact is the full damper, as releasedSigma0 takes it; r ∝ 1/T60 (D2).
+  const double c = contact < 1.0 ? std::max(contact, 0.0) : 1.0;
+  const double scale = damperScale > 0.0 ? damperScale : 1.0;
+  for (int m = 0; m < feltNodes_; ++m) scheme_->setPointDamper(m, feltNode_[m], c * feltR_ / scale);
 }
 
 // The back-check: once the hammer has struck and left the string (escapement: no force drives

@@ -2,6 +2,7 @@
 // note, oversampled and decimated to the audio rate, with damper, pickups and a guard.
 #pragma once
 
+#include <array>
 #include <memory>
 #include <optional>
 #include <span>
@@ -33,7 +34,12 @@ struct StringPatch {
   double t60Low = 20.0;  // s, decay time at 0 Hz (infinite: no loss)
   double t60High = 4.0;  // s, decay time at t60HighHz
   double t60HighHz = 2000.0;
-  double damperT60 = 0.25;           // s, decay time once released
+  double damperT60 = 0.25;  // s, the fundamental's T60 added once released (the felt's share)
+  // false: the damper adds ln(1000)/damperT60 to σ0, every partial alike (releasedSigma0); true:
+  // its felt, from damperPosition·L and damperWidth long, damps each by its shape there (D2).
+  bool feltDamper = false;
+  double damperPosition = 0.135;     // fraction of L
+  double damperWidth = 0.02;         // m
   double pickups[2] = {0.31, 0.73};  // fractions of L
   int channels = 2;                  // 1: mono from pickups[0]; 2: one pickup per channel
   PickupSignal signal = PickupSignal::velocity;
@@ -67,9 +73,12 @@ class StringVoice {
   void reset() noexcept;  // the string at rest, the hammer parked, the damper up
 
   void noteOn(double velocity) noexcept;  // velocity 0 … 1
-  // The damper falls, its T60 damper_t60_s times `damperScale` (releasedSigma0), touching the
-  // string with `contact` 0 … 1 of its loss (the half-pedal; 0: lifted, the voice's own loss).
-  // May be called again at any time to move the damper: the loss changes between two steps.
+  // The damper falls, the fundamental's T60 damper_t60_s times `damperScale` added: uniform, every
+  // partial alike (releasedSigma0); felt, its felt presses on the string along its width (dashpots
+  // on the nodes under it, SavScheme::setPointDamper), each mode damped by its shape there — a
+  // mode with a node near the felt less (D2). `contact` 0 … 1 scales the loss added (the
+  // half-pedal; 0: lifted, the voice's own loss). May be called again at any time to move the
+  // damper: the loss changes between two steps.
   void release(double damperScale = 1.0, double contact = 1.0) noexcept;
   // Bends the pitch by `semitones` (clamped to ±bendRange) by retensioning the transverse wave:
   // β T0 is solved in closed form so the scheme's fundamental moves by exactly that interval.
@@ -92,6 +101,10 @@ class StringVoice {
   double pullOnBridge(double w) const noexcept { return coupling_.forceOnBridge(scheme_->q(), w); }
   const BridgeCoupling& coupling() const { return coupling_; }
   const StringPatch& patch() const { return patch_; }
+  // The nodes of u (coordinates of q) under a felt damper; empty with the uniform one.
+  std::span<const Eigen::Index> feltNodes() const {
+    return {feltNode_.data(), static_cast<size_t>(patch_.feltDamper ? feltNodes_ : 0)};
+  }
 
   bool active() const { return active_; }
   double energy() const;                               // the scheme's H^{n+½} (ε excluded), J
@@ -119,6 +132,10 @@ class StringVoice {
   QuietDetector quiet_;
   StringLoss loss_;
   BridgeCoupling coupling_;  // of the string as bent now
+  // The felt's nodes (u's coordinates) and its resistance at each at full contact, kg/s (D2).
+  std::array<Eigen::Index, SplitSav<HammeredString>::kPointDampers> feltNode_{};
+  int feltNodes_ = 0;
+  double feltR_ = 0.0;
   double sampleRate_ = 0.0, k_ = 0.0, fundamental_ = 0.0;
   double bend_ = 0.0, bendSlope_ = 0.0, bendOffset_ = 0.0;  // λ1(β) = bendSlope_·β + bendOffset_
   double injected_ = 0.0, caught_ = 0.0;
