@@ -42,6 +42,7 @@ SECTIONS = [
     "string_grids",  # the string's grid rules on the piano: glide, phantom partials, cost
     "dynamics",      # loudness across velocity and register; the fortissimo passage's headroom
     "body",          # the bridge's two-stage decay, the pedal's sympathetic ring
+    "damper",        # key-off: each partial's decay under the felt damper
 ]
 
 

@@ -17,10 +17,14 @@ FIGURES = ["body_two_stage_decay", "body_sympathetic_spectrum"]
 C4 = 440.0 * 2 ** ((60 - 69) / 12)
 
 
-def render(ctx, name, preset, source, seconds, extra=()):
+def render(ctx, name, preset, source, seconds, extra=(), tail=None):
+    """The left channel and the rate; `tail` s after the last event (default: none after --notes,
+    `seconds` after a MIDI file)."""
     path = ctx.path(name + ".wav")
+    if tail is None:
+        tail = 0 if source[0] == "--notes" else seconds
     args = [ctx.render, "--preset", ctx.source + "/presets/" + preset + ".toml", *source,
-            "--tail", 0 if source[0] == "--notes" else seconds, *extra, "--format", "pcm24",
+            "--tail", tail, *extra, "--format", "pcm24",
             "--quiet", "-o", path]
     ctx.run(args)
     x, rate = read_wav(path)
