@@ -441,7 +441,8 @@ constexpr Parameter kTable[] = {
      .defaultText = "0.135",
      .model = kString,
      .perKey = true,
-     .doc = "Where the damper's felt begins, as a fraction of the length from the hammer's end."},
+     .doc = "Where the damper's felt begins, as a fraction of the length from the agraffe (the "
+            "hammer's end, x = 0)."},
     {.name = "damper.width_m",
      .unit = "m",
      .min = 0,
@@ -449,8 +450,8 @@ constexpr Parameter kTable[] = {
      .defaultText = "0.02",
      .model = kString,
      .perKey = true,
-     .doc = "The felt's length along the string: it damps at both its ends, so that no partial "
-            "has a node under the whole felt."},
+     .doc = "The felt's length along the string: it damps on every node of the string's grid "
+            "under it (at most 8, spread evenly, both ends included)."},
     {.name = "loss.t60_low_s",
      .unit = "s",
      .min = 0.01,

@@ -119,9 +119,10 @@ class SavScheme {
   // takes r/(4k) (q_i^{n+1} − q_i^{n−1})² >= 0 of the energy, tallied in dissipated(): the scheme
   // stays dissipative and stable for any r >= 0.
   static constexpr int kPointDampers = 8;
+  // Slots on one coordinate add; an r that is not > 0 (NaN too) lifts the slot.
   void setPointDamper(int slot, Eigen::Index i, double r) noexcept {
     damperIndex_[slot] = i;
-    damperR_[slot] = r;
+    damperR_[slot] = r > 0.0 ? r : 0.0;
     damped_ = false;
     for (double x : damperR_) damped_ = damped_ || x > 0.0;
   }
@@ -276,10 +277,16 @@ class SavScheme {
     // bDamped_m: b'_m, b at the damped coordinate before U y.
     double bDamped[kPointDampers] = {}, dDamped[kPointDampers] = {};
     if (damped_) {
+      // d per slot, the slots on one coordinate gathered into the first of them.
+      for (int m = 0; m < kPointDampers; ++m) {
+        if (damperR_[m] == 0.0) continue;
+        int first = 0;  // stops at m at the latest
+        while (damperIndex_[first] != damperIndex_[m] || damperR_[first] == 0.0) ++first;
+        dDamped[first] += 0.5 * damperR_[m] * k * minv[damperIndex_[m]];
+      }
       for (int m = 0; m < kPointDampers; ++m) {
         const Eigen::Index i = damperIndex_[m];
-        const double d = 0.5 * damperR_[m] * k * minv[i];
-        dDamped[m] = d;
+        const double d = dDamped[m];
         if (d == 0.0) continue;
         double b = 2.0 * q[i] - down * qm[i] + d * qm[i];
         if constexpr (splitK) b -= kk * (minv[i] * kq[i]);
@@ -340,8 +347,8 @@ class SavScheme {
       const double dx = x - qp[i];
       qp[i] = x;
       for (int a = 0; a < parts; ++a) gdq[a] += g[a][i] * dx;
-      if (params_.trackDissipation)
-        dissipated_ += damperR_[m] / (4.0 * k) * (x - qm[i]) * (x - qm[i]);  // (D1)
+      if (params_.trackDissipation)  // r/(4k) Δ², r = 2d/(k M⁻¹_ii)  (D1)
+        dissipated_ += d / (2.0 * k * k * minv[i]) * (x - qm[i]) * (x - qm[i]);
     }
     for (int p = 0; p < kPointForces; ++p)
       supplied_ += 0.5 * pointForce_[p] * (qp[pointIndex_[p]] - qm[pointIndex_[p]]);

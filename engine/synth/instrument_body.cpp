@@ -7,12 +7,9 @@
 #include <stdexcept>
 
 #include "instruments/piano_scale.h"
+#include "voices/string_voice.h"
 
 namespace hamiltone {
-
-namespace {
-constexpr double kNoDamperT60 = 1000.0;  // s: loss.damper_t60_s's largest value, "no damper"
-}  // namespace
 
 std::vector<SympatheticKey> sympatheticKeys(const Instrument& instrument) {
   std::vector<SympatheticKey> keys;

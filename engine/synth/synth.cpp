@@ -68,6 +68,7 @@ void Synth::prepare(std::vector<Instrument> instruments, const SynthSetup& setup
     body->driving.assign(count, nullptr);
     body->drivers.assign(count, 0);
     body->struck.assign(count, 0);
+    body->excludedAt.assign(count, kNever);
     body->contact.assign(count, -1.0);
     body->gain = instrument.body.gain * gains[p];
     body->fadeSamples =
@@ -272,8 +273,9 @@ void Synth::setBend(double fraction) noexcept {
 void Synth::allSoundOff() noexcept {
   for (auto& keys : voices_)
     for (KeyVoice& v : keys) v.fadeOut();
+  // Resting or not: a voice struck just before may still wake it, and the fade covers that too.
   for (auto& body : bodies_)
-    if (body && !body->resting && body->fadeLeft == 0) body->fadeLeft = body->fadeSamples;
+    if (body && body->fadeLeft == 0) body->fadeLeft = body->fadeSamples;
   std::fill(std::begin(downProgram_), std::end(downProgram_), -1);
 }
 
@@ -378,6 +380,7 @@ void Synth::renderBody(size_t program, std::span<float> left, std::span<float> r
     b.driving[d] = v.boardForce().data();
     if (v.order() != b.struck[key]) {  // struck since: its strings are the voice's now
       b.struck[key] = v.order();
+      b.excludedAt[key] = b.clock;
       b.body.setExcluded(key, true);
     }
   }
@@ -392,6 +395,7 @@ void Synth::renderBody(size_t program, std::span<float> left, std::span<float> r
   }
   if (b.resting && drivers == 0) {
     b.clock += static_cast<long>(left.size());
+    b.fadeLeft = static_cast<int>(std::max(0L, b.fadeLeft - static_cast<long>(left.size())));
     return;
   }
   for (size_t i = 0; i < left.size(); ++i) {
@@ -406,10 +410,6 @@ void Synth::renderBody(size_t program, std::span<float> left, std::span<float> r
       b.lastPush = b.clock;
     }
     ++b.clock;
-    if (b.resting) continue;
-    b.body.step(b.forces);
-    double l, r;
-    b.body.output(l, r);
     // Linear to zero, as a voice fades (KeyVoice::render).
     double gain = b.gain;
     bool silenced = false;
@@ -417,6 +417,10 @@ void Synth::renderBody(size_t program, std::span<float> left, std::span<float> r
       gain *= static_cast<double>(--b.fadeLeft) / b.fadeSamples;
       silenced = b.fadeLeft == 0;
     }
+    if (b.resting) continue;
+    b.body.step(b.forces);
+    double l, r;
+    b.body.output(l, r);
     left[i] += static_cast<float>(gain * l);
     right[i] += static_cast<float>(gain * r);
     if (std::max(std::abs(b.gain * l), std::abs(b.gain * r)) > QuietDetector::kFloor)
@@ -427,11 +431,13 @@ void Synth::renderBody(size_t program, std::span<float> left, std::span<float> r
   }
 }
 
-// At rest, exactly; every key's strings back on the board.
+// At rest, exactly; every key's strings back on the board — but those of a key struck in the
+// last kBodyRestCheck samples, whose voice may not have pushed yet (its hammer in flight) or was
+// struck during a CC120's fade: they are the voice's until the next rest.
 void Synth::rest(Body& b) noexcept {
   b.body.reset();
   for (size_t key = 0; key < b.forces.size(); ++key) {
-    b.body.setExcluded(static_cast<int>(key), false);
+    b.body.setExcluded(static_cast<int>(key), b.clock - b.excludedAt[key] < kBodyRestCheck);
     b.forces[key] = 0.0;
   }
   b.fadeLeft = 0;

@@ -131,7 +131,8 @@ class Synth {
     std::vector<int> drivers;    // the keys rendered this piece (driverCount), in order …
     int driverCount = 0;
     std::vector<const float*> driving;  // … and their board forces
-    std::vector<long> struck;           // per key, the strike (KeyVoice::order) it last saw
+    std::vector<long> struck;           // per key, the strike (KeyVoice::order) it last saw …
+    std::vector<long> excludedAt;       // … and `clock` then: left out of the coupling since
     std::vector<double> contact;        // per key, as last told (−1: not yet)
     double gain = 1.0;                  // body.gain times the instrument's
     long clock = 0, lastPush = 0;       // samples since prepare(); the last with a force …
@@ -142,6 +143,7 @@ class Synth {
   static constexpr long kBodyRestCheck = 4096;  // samples between the body's rest checks
   void renderBody(size_t program, std::span<float> left, std::span<float> right) noexcept;
   static void rest(Body& b) noexcept;
+  static constexpr long kNever = -(1L << 40);  // a clock long before any sample
 
   std::vector<Instrument> instruments_;
   std::vector<std::vector<KeyVoice>> voices_;  // [instrument][note − lowest]

@@ -180,11 +180,9 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
     felt[m] = feltNodes == 1 ? first : first + (last - first) * m / (feltNodes - 1);
     shape += std::pow(std::sin(std::numbers::pi * (felt[m] + 1) / segments), 2);
   }
-  // loss.damper_t60_s's largest value, 1000 s, says "no damper" (F6 up): no felt to step.
-  const double feltR =
-      patch.damperT60 >= 1000.0
-          ? 0.0
-          : kLn1000 / patch.damperT60 * tuned.physics.linearDensity() * length / shape;
+  const double feltR = kLn1000 / patch.damperT60 * tuned.physics.linearDensity() * length / shape;
+  // The uniform damper has no felt, nor a key without a damper (kNoDamperT60).
+  const bool hasFelt = patch.feltDamper && patch.damperT60 < kNoDamperT60;
   const double epsilon = gaugeShift(patch, string, k);
   string.setTensionRange(betaMax);
   const HammeredString system(std::move(string), patch.hammer);
@@ -204,7 +202,7 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
   sampleRate_ = sampleRate;
   k_ = k;
   feltNode_ = felt;
-  feltNodes_ = feltR > 0.0 ? feltNodes : 0;
+  feltNodes_ = hasFelt ? feltNodes : 0;
   feltR_ = feltR;
   loss_ = loss;
   fundamental_ = schemePartial(system.string(), k, 1);

@@ -50,6 +50,9 @@ struct StringPatch {
   double bendRange = 2.0;  // semitones each way that setBend() reaches; 0 keeps the finest grid
 };
 
+// loss.damper_t60_s's largest value: the preset's "no damper" (the keys from F6 up).
+constexpr double kNoDamperT60 = 1000.0;  // s
+
 constexpr double kEpsilonShare = 0.1;
 // On a grid that does not resolve the longitudinal wave, the largest ε as a share of that energy.
 constexpr double kUnresolvedEpsilonShare = 0.01;
@@ -101,9 +104,9 @@ class StringVoice {
   double pullOnBridge(double w) const noexcept { return coupling_.forceOnBridge(scheme_->q(), w); }
   const BridgeCoupling& coupling() const { return coupling_; }
   const StringPatch& patch() const { return patch_; }
-  // The nodes of u (coordinates of q) under a felt damper; empty with the uniform one.
+  // The nodes of u (coordinates of q) under a felt damper; none with the uniform one or none.
   std::span<const Eigen::Index> feltNodes() const {
-    return {feltNode_.data(), static_cast<size_t>(patch_.feltDamper ? feltNodes_ : 0)};
+    return {feltNode_.data(), static_cast<size_t>(feltNodes_)};
   }
 
   bool active() const { return active_; }
