@@ -123,8 +123,16 @@ class SavScheme {
   void setPointDamper(int slot, Eigen::Index i, double r) noexcept {
     damperIndex_[slot] = i;
     damperR_[slot] = r > 0.0 ? r : 0.0;
+    // d = r k M⁻¹_ii / 2 per slot, the slots on one coordinate gathered into the first of them.
+    damperD_.fill(0.0);
     damped_ = false;
-    for (double x : damperR_) damped_ = damped_ || x > 0.0;
+    for (int m = 0; m < kPointDampers; ++m) {
+      if (damperR_[m] == 0.0) continue;
+      int first = 0;  // stops at m at the latest
+      while (damperIndex_[first] != damperIndex_[m] || damperR_[first] == 0.0) ++first;
+      damperD_[first] += 0.5 * damperR_[m] * params_.k * system_.inverseMass()[damperIndex_[m]];
+      damped_ = true;
+    }
   }
 
   // Sets coordinate i at levels n and n+1 — a hammer placed and launched, or caught. The caller
@@ -275,18 +283,11 @@ class SavScheme {
     // with D: y = ((1+σ0k) I + W)⁻¹ z, W = (1+σ0k) Vᵀ D⁻¹ U, z = (1+σ0k) Vᵀ D⁻¹ b', and
     // q^{n+1} = D⁻¹ (b' − U y) — the undamped coordinates as before, the damped ones below.
     // bDamped_m: b'_m, b at the damped coordinate before U y.
-    double bDamped[kPointDampers] = {}, dDamped[kPointDampers] = {};
+    double bDamped[kPointDampers] = {};
     if (damped_) {
-      // d per slot, the slots on one coordinate gathered into the first of them.
-      for (int m = 0; m < kPointDampers; ++m) {
-        if (damperR_[m] == 0.0) continue;
-        int first = 0;  // stops at m at the latest
-        while (damperIndex_[first] != damperIndex_[m] || damperR_[first] == 0.0) ++first;
-        dDamped[first] += 0.5 * damperR_[m] * k * minv[damperIndex_[m]];
-      }
       for (int m = 0; m < kPointDampers; ++m) {
         const Eigen::Index i = damperIndex_[m];
-        const double d = dDamped[m];
+        const double d = damperD_[m];
         if (d == 0.0) continue;
         double b = 2.0 * q[i] - down * qm[i] + d * qm[i];
         if constexpr (splitK) b -= kk * (minv[i] * kq[i]);
@@ -338,7 +339,7 @@ class SavScheme {
     }
     // The damped coordinates: D⁻¹ (b' − U y) there, b' − U y = b'_m − Σ_j α_j y_j.
     for (int m = 0; damped_ && m < kPointDampers; ++m) {
-      const double d = dDamped[m];
+      const double d = damperD_[m];
       if (d == 0.0) continue;
       const Eigen::Index i = damperIndex_[m];
       double x = bDamped[m];
@@ -412,6 +413,7 @@ class SavScheme {
   std::array<double, kPointForces> pointForce_{};
   std::array<Eigen::Index, kPointDampers> damperIndex_{};
   std::array<double, kPointDampers> damperR_{};  // kg/s; 0: lifted
+  std::array<double, kPointDampers> damperD_{};  // (D1)'s d, gathered per coordinate
   bool damped_ = false;
   double supplied_ = 0.0;  // work of f and of the point forces since the start
   double dissipated_ = 0.0;

@@ -37,7 +37,7 @@ void KeyVoice::prepare(const Instrument& instrument, int note, double sampleRate
   for (auto* buffer : {&mixLeft_, &mixRight_, &outLeft_, &outRight_, &boardForce_})
     buffer->assign(maxBlock, 0.0f);
   frames_ = 0;
-  fadeSamples_ = std::max(1, static_cast<int>(std::lround(kFadeS * sampleRate)));
+  fadeSamples_ = fadeSamples(sampleRate);
   envelopeDecay_ = std::exp(-1.0 / (kEnvelopeS * sampleRate));
   attackSamples_ = std::lround(kEnvelopeS * sampleRate);
   sinceStrike_ = attackSamples_;

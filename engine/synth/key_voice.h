@@ -3,6 +3,8 @@
 // fading out when stolen.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <span>
 #include <variant>
 #include <vector>
@@ -15,7 +17,10 @@ namespace hamiltone {
 
 class KeyVoice {
  public:
-  static constexpr double kFadeS = 0.005;     // a stolen or silenced voice fades over 5 ms
+  static constexpr double kFadeS = 0.005;      // a stolen or silenced voice fades over 5 ms
+  static int fadeSamples(double sampleRate) {  // kFadeS in samples, at least one
+    return std::max(1, static_cast<int>(std::lround(kFadeS * sampleRate)));
+  }
   static constexpr double kEnvelopeS = 0.05;  // the loudness follower's release time constant
 
   // May allocate; throws std::invalid_argument naming the patch field (from the voices). With

@@ -71,8 +71,7 @@ void Synth::prepare(std::vector<Instrument> instruments, const SynthSetup& setup
     body->excludedAt.assign(count, kNever);
     body->contact.assign(count, -1.0);
     body->gain = instrument.body.gain * gains[p];
-    body->fadeSamples =
-        std::max(1, static_cast<int>(std::lround(KeyVoice::kFadeS * setup.sampleRate)));
+    body->fadeSamples = KeyVoice::fadeSamples(setup.sampleRate);
     bodies[p] = std::move(body);
   }
   MasterBus master;
