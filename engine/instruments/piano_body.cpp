@@ -18,14 +18,12 @@ void PianoBody::prepare(const PianoBodySpec& spec, std::span<const BoardPoint> b
                    spec.sympatheticMaxPartials);
   forces_.setZero(board_.points());
   active_.reserve(board_.points());
-  driven_.assign(board_.points(), 0);
   reset();
 }
 
 void PianoBody::reset() noexcept {
   board_.reset();
   strings_.reset();
-  std::fill(driven_.begin(), driven_.end(), 0);
   updateActivePoints();
   supplied_ = switched_ = 0.0;
   sinceCheck_ = 0;
@@ -33,31 +31,26 @@ void PianoBody::reset() noexcept {
 
 void PianoBody::step(std::span<const double> bridgeForces) noexcept {
   const int n = board_.points();
-  bool newlyDriven = false;
-  for (int k = 0; k < n; ++k)
-    if (bridgeForces[k] != 0.0 && !driven_[k]) {
-      driven_[k] = 1;
-      if (!strings_.coupled(k) && !strings_.excluded(k)) {  // out of use until now
-        board_.refreshPoint(k);
-        newlyDriven = true;
-      }
-    }
-  if (newlyDriven) updateActivePoints();
   const Eigen::VectorXd& w = board_.displacements();  // w^n; after board_.step(), w^{n+1}
-  double before = 0.0;                                // Σ F_k w_k^{n−1}
-  const double* wPrev = board_.previousDisplacements().data();
-#pragma omp simd reduction(+ : before)
-  for (int k = 0; k < n; ++k) before += bridgeForces[k] * wPrev[k];
   forces_.setZero();
   strings_.step(w, {forces_.data(), static_cast<std::size_t>(n)});  // (Y3), (Y4) with w^n
+  // The voices' work, Σ_k F_k (w_k^{n+1} − w_k^{n−1})/2, is the board's (S3) — every force's,
+  // from its modes, so w is needed at no driven point — less the strings' (Y4) forces', which
+  // are zero but at coupled keys, the points in use.
+  double before = 0.0;  // Σ F_strings,k w_k^{n−1}
+  const double* wPrev = board_.previousDisplacements().data();
+  const double* fs = forces_.data();
+#pragma omp simd reduction(+ : before)
+  for (int k = 0; k < n; ++k) before += fs[k] * wPrev[k];
+  const double boardBefore = board_.supplied();
   board_.addForces({forces_.data(), static_cast<std::size_t>(n)});
   board_.addForces(bridgeForces);
   board_.step();
-  double after = 0.0;  // Σ F_k w_k^{n+1}
+  double after = 0.0;  // Σ F_strings,k w_k^{n+1}
   const double* wNext = board_.displacements().data();
 #pragma omp simd reduction(+ : after)
-  for (int k = 0; k < n; ++k) after += bridgeForces[k] * wNext[k];
-  supplied_ += 0.5 * (after - before);
+  for (int k = 0; k < n; ++k) after += fs[k] * wNext[k];
+  supplied_ += (board_.supplied() - boardBefore) - 0.5 * (after - before);
   if (++sinceCheck_ == kCheckEvery) sleepQuietKeys();
 }
 
@@ -79,7 +72,7 @@ void PianoBody::sleepQuietKeys() noexcept {
 void PianoBody::updateActivePoints() noexcept {
   active_.clear();  // within the capacity reserved in prepare
   for (int key = 0; key < keys(); ++key)
-    if (strings_.coupled(key) || strings_.excluded(key) || driven_[key]) active_.push_back(key);
+    if (strings_.coupled(key)) active_.push_back(key);
   board_.setActivePoints(active_);
 }
 

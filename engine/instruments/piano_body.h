@@ -27,23 +27,24 @@ class PianoBody {
                std::span<const SympatheticKey> keys);
   void reset() noexcept;
 
-  // One force per key point, N. A key once driven stays a point in use (until reset()).
+  // One force per key point, N, at any point: the board takes it through its modes.
   void step(std::span<const double> bridgeForces) noexcept;
   void output(double& left, double& right) const noexcept { board_.pickups(left, right); }
 
   // Lifting a sleeping key's damper wakes it (below).
   void setDamper(int key, double contact) noexcept;
   // A key a voice is playing: its sympathetic strings leave the coupling; the energy they take
-  // away (or bring back) is booked in dissipated(), so the balance holds across the switch. Its
-  // point stays in use: the voice reads displacement(key) and drives it.
+  // away (or bring back) is booked in dissipated(), so the balance holds across the switch. The
+  // voice drives its point through step()'s forces.
   void setExcluded(int key, bool excluded) noexcept;
-  // Points in use, so the cost is modes × (1 + points in use): every 256 steps a key whose damper
-  // is on and whose strings ring (about the shape the bridge gives them) with less than the floor
-  // (J) sleeps — it leaves the coupling, booked like an exclusion — until its damper lifts. Keys
-  // without dampers never sleep. The floor is the larger of `joules` and `relative` times the
-  // body's energy: damped strings still ring a little while the voices drive the board (1e-3 to
-  // 1e-2 of it each, measured), so only a relative floor lets them sleep then — at the price of
-  // that ring.
+  // Points in use: where the board computes w, the keys whose strings are coupled. A step costs
+  // modes × (points in use + points driven) for the board's two products, and the coupled keys'
+  // partials. Every 256 steps a key whose damper is on and whose strings ring (about the shape the
+  // bridge gives them) with less than the floor (J) sleeps — it leaves the coupling, booked like an
+  // exclusion — until its damper lifts. Keys without dampers never sleep. The floor is the larger
+  // of `joules` and `relative` times the body's energy: damped strings still ring a little while
+  // the voices drive the board (1e-3 to 1e-2 of it each, measured), so only a relative floor lets
+  // them sleep then — at the price of that ring.
   void setQuietFloor(double joules, double relative = 0.0) noexcept {
     quietFloor_ = joules;
     quietRelative_ = relative;
@@ -68,7 +69,6 @@ class PianoBody {
   void updateActivePoints() noexcept;
   Eigen::VectorXd forces_;  // the strings' (Y4), per point
   std::vector<int> active_;
-  std::vector<char> driven_;  // keys a force has reached: their points stay in use
   double supplied_ = 0.0, switched_ = 0.0;
   double quietFloor_ = 1e-12, quietRelative_ = 0.0;
   int sinceCheck_ = 0;

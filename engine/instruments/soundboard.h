@@ -44,7 +44,8 @@ class Soundboard {
 
   int points() const noexcept { return static_cast<int>(phi_.rows()); }
   // The points in use (all after prepare): step() computes w at these only, the others keep
-  // stale values; forces belong at points in use. Copies; no allocation.
+  // stale values. Forces may act at any point: they reach the modes whatever this list, and so
+  // does their work in supplied(). Copies; no allocation.
   void setActivePoints(std::span<const int> points) noexcept;
   int activePoints() const noexcept { return activeCount_; }
   // w and the previous level's w at one point, brought up to date (before it is put in use).

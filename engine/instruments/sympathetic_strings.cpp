@@ -150,6 +150,7 @@ void SympatheticStrings::prepare(std::span<const SympatheticKey> keys, const Sou
   b_.resize(total);
   bPrev_.resize(total);
   contact_.assign(keyCount, 0.0);
+  runs_.reserve(keyCount);
   excluded_.assign(keyCount, 0);
   asleep_.assign(keyCount, 0);
   for (int key = 0; key < keyCount; ++key) setCoefficients(key);
@@ -225,6 +226,7 @@ double SympatheticStrings::couple(int key, double w, double wPrev) noexcept {
   if (on == (kappa_[key] != 0.0)) return 0.0;
   const double before = keyEnergy(key) + keyCoupling(key, w, wPrev);
   kappa_[key] = on ? kappaOn_[key] : 0.0;
+  runsStale_ = true;
   for (int n = 1; n <= partials_[key]; ++n) {
     const Eigen::Index j = slot(key, n);
     c_[j] = on ? cOn_[j] : 0.0;
@@ -254,7 +256,24 @@ bool SympatheticStrings::damped(int key) const noexcept {
   return contact_[key] >= 1.0 && !std::isinf(data_[key].damperT60);
 }
 
+// The coupled keys as runs [first, last), gaps under kRunGap keys bridged: an uncoupled key's
+// partials are at rest with no coupling (couple()), so stepping it leaves zeros and adds nothing
+// to the forces or the loss — skipping it or not gives the same bits.
+void SympatheticStrings::findRuns() noexcept {
+  constexpr int kRunGap = 4;  // one AVX2 register of keys
+  runs_.clear();              // within the capacity reserved in prepare
+  for (int key = 0; key < keys_; ++key) {
+    if (!coupled(key)) continue;
+    if (!runs_.empty() && key - runs_.back().second < kRunGap)
+      runs_.back().second = key + 1;
+    else
+      runs_.push_back({key, key + 1});
+  }
+  runsStale_ = false;
+}
+
 void SympatheticStrings::step(const Eigen::VectorXd& w, std::span<double> forces) noexcept {
+  if (runsStale_) findRuns();
   const long keyCount = keys_;
   const double* wk = w.data();
   double* f = forces.data();
@@ -262,16 +281,15 @@ void SympatheticStrings::step(const Eigen::VectorXd& w, std::span<double> forces
 #pragma omp simd
   for (long key = 0; key < keyCount; ++key) f[key] -= kappa[key] * wk[key];  // (Y4): −κ w^n
   for (int row = 0; row < rows_; ++row) {
-    const long at = row * keyCount, length = rowLength_[row];
-    const double* a1 = a1_.data() + at;
-    const double* a2 = a2_.data() + at;
-    const double* a3 = a3_.data() + at;
-    const double* c = c_.data() + at;
-    const double* sigma = sigma_.data() + at;
-    const double* b = b_.data() + at;
-    double* prev = bPrev_.data() + at;  // a^{n−1} in, a^{n+1} out
-    double* lost = lost_.data() + at;  // σ d² per slot (no chain of sums); × M/2k: k 2Mσ (δt· a)²
-    loops_->partialsRow(length, a1, a2, a3, c, sigma, b, wk, prev, lost, f);  // (Y3), (Y4)
+    for (const auto& [first, last] : runs_) {
+      const long length = std::min<long>(last, rowLength_[row]) - first;
+      if (length <= 0) break;  // the runs ascend: the row ends before this one
+      const long at = row * keyCount + first;
+      double* lost = lost_.data() + at;  // σ d² per slot (no chain of sums); × M/2k: k 2Mσ (δt· a)²
+      loops_->partialsRow(length, a1_.data() + at, a2_.data() + at, a3_.data() + at, c_.data() + at,
+                          sigma_.data() + at, b_.data() + at, wk + first, bPrev_.data() + at, lost,
+                          f + first);  // (Y3), (Y4); bPrev_: a^{n−1} in, a^{n+1} out
+    }
   }
   b_.swap(bPrev_);
 }

@@ -79,7 +79,7 @@ class SympatheticStrings {
   bool damped(int key) const noexcept;
 
   // (Y3): level n → n+1 given w = w^n; adds the strings' forces (Y4) at level n on the board's
-  // points to `forces`, N (one pass over the partials for both).
+  // points to `forces`, N (one pass over the coupled keys' partials for both).
   void step(const Eigen::VectorXd& w, std::span<double> forces) noexcept;
 
   // H_strings + H_c at n+½ given w^{n+1} (w) and w^n (wPrev), J.
@@ -103,6 +103,7 @@ class SympatheticStrings {
     return static_cast<Eigen::Index>(n - 1) * keys_ + key;
   }
   void setCoefficients(int key) noexcept;
+  void findRuns() noexcept;
   double couple(int key, double w, double wPrev) noexcept;  // applies coupled(key); the jump
   double keyCoupling(int key, double w, double wPrev) const noexcept;
   std::vector<SympatheticKey> data_;
@@ -112,6 +113,8 @@ class SympatheticStrings {
   const BodyLoops* loops_ = nullptr;
   std::vector<double> contact_;
   std::vector<char> excluded_, asleep_;
+  std::vector<std::pair<int, int>> runs_;  // the keys step() steps: [first, last), ascending
+  bool runsStale_ = true;
   Eigen::VectorXd kappa_, kappaOn_;  // κ_k in use (0 when excluded) and as prepared
   // Per partial slot (n − 1) keys + key: mass, K̂, ω, own σ, σ in use, coupling in use and as
   // prepared, step coefficients.
