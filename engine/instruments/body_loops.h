@@ -10,7 +10,7 @@ struct BodyLoops {
   // w_k = Σ_m φ[k ld + m] a_m for the `count` points k = rows[0 … count).
   void (*gather)(const float* phi, long ld, const int* rows, long count, long modes,
                  const double* a, double* w);
-  // g_m = Σ_k φ[k ld + m] f_k for m < modes; points with f_k = 0 are skipped (not in use).
+  // g_m = Σ_k φ[k ld + m] f_k for m < modes; points with f_k = 0 (no force) are skipped.
   void (*project)(const float* phi, long ld, long points, long modes, const double* f, double* g);
   // Partial n of keys 0 … keys − 1 (sympathetic_strings.h (Y3), (Y4)): f −= c b; next = a1 b −
   // a2 prev − a3 c w into prev; lost += σ (next − prev)².

@@ -42,7 +42,6 @@ void PianoBody::step(std::span<const double> bridgeForces) noexcept {
   const double* fs = forces_.data();
 #pragma omp simd reduction(+ : before)
   for (int k = 0; k < n; ++k) before += fs[k] * wPrev[k];
-  const double boardBefore = board_.supplied();
   board_.addForces({forces_.data(), static_cast<std::size_t>(n)});
   board_.addForces(bridgeForces);
   board_.step();
@@ -50,7 +49,7 @@ void PianoBody::step(std::span<const double> bridgeForces) noexcept {
   const double* wNext = board_.displacements().data();
 #pragma omp simd reduction(+ : after)
   for (int k = 0; k < n; ++k) after += fs[k] * wNext[k];
-  supplied_ += (board_.supplied() - boardBefore) - 0.5 * (after - before);
+  supplied_ += board_.lastWork() - 0.5 * (after - before);
   if (++sinceCheck_ == kCheckEvery) sleepQuietKeys();
 }
 

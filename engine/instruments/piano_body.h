@@ -58,6 +58,7 @@ class PianoBody {
   double supplied() const noexcept { return supplied_; }
 
   int keys() const noexcept { return board_.points(); }
+  // w at a key's point: current where its strings are coupled (a point in use), stale elsewhere.
   double displacement(int key) const noexcept { return board_.displacement(key); }
   const Soundboard& board() const noexcept { return board_; }
   const SympatheticStrings& strings() const noexcept { return strings_; }

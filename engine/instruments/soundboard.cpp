@@ -130,7 +130,7 @@ void Soundboard::reset() noexcept {
   force_.setZero();
   w_.setZero();
   wPrev_.setZero();
-  dissipated_ = supplied_ = 0.0;
+  dissipated_ = supplied_ = lastWork_ = 0.0;
 }
 
 double Soundboard::shape(int mode, const BoardPoint& p) const noexcept {
@@ -167,7 +167,8 @@ void Soundboard::step() noexcept {
     prev[i] = next;
   }
   dissipated_ += mass_ * lost / (2.0 * k_);
-  supplied_ += 0.5 * work;  // Σ_k F_k (w^{n+1} − w^{n−1})/2 = Σ_m g_m (a^{n+1} − a^{n−1})/2
+  lastWork_ = 0.5 * work;  // Σ_k F_k (w^{n+1} − w^{n−1})/2 = Σ_m g_m (a^{n+1} − a^{n−1})/2
+  supplied_ += lastWork_;
   a_.swap(aPrev_);
   wPrev_.swap(w_);
   loops_->gather(phi_.data(), n, active_.data(), activeCount_, n, a_.data(), w_.data());  // w = Φa

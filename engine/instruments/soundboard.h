@@ -63,6 +63,7 @@ class Soundboard {
   double energy() const noexcept;  // H^{n−½} of (S2), J
   double dissipated() const noexcept { return dissipated_; }
   double supplied() const noexcept { return supplied_; }
+  double lastWork() const noexcept { return lastWork_; }  // the last step's share of supplied()
 
   int modes() const noexcept { return static_cast<int>(omega_.size()); }
   double modeHz(int mode) const noexcept;
@@ -93,7 +94,7 @@ class Soundboard {
   Eigen::VectorXd a_, aPrev_, g_, force_, w_, wPrev_;
   std::vector<int> active_;  // points in use, active_[0 … activeCount_)
   int activeCount_ = 0;
-  double dissipated_ = 0.0, supplied_ = 0.0;
+  double dissipated_ = 0.0, supplied_ = 0.0, lastWork_ = 0.0;
 };
 
 // Where the keys cross the bridges, in fractions of lx and ly: the bass bridge from A0 to E2 and

@@ -165,6 +165,7 @@ void SympatheticStrings::reset() noexcept {
   b_.setZero();
   bPrev_.setZero();
   lost_.setZero();
+  runsStale_ = true;  // a second prepare() may find every key coupled already (couple() skips)
 }
 
 void SympatheticStrings::setCoefficients(int key) noexcept {
@@ -315,8 +316,8 @@ namespace hamiltone {
 
 namespace {
 
-// docs/instrument-data.md §3.2: MIDI, the STK column's T60 (s, unused here: it holds the board's
-// loss too, §3.6), T60 after release (s; 0: none).
+// docs/instrument-data.md §3.2: MIDI, single-string T60 (s, unused here: it holds the board's
+// loss too), T60 after release (s; 0: none).
 constexpr double kDecay[][3] = {
     {21, 40.0, 1.73}, {24, 40.0, 1.65}, {28, 40.0, 1.48}, {29, 10.0, 1.44}, {33, 10.0, 1.24},
     {36, 10.0, 1.12}, {40, 9.9, 0.92},  {45, 9.2, 0.73},  {48, 8.6, 0.63},  {52, 8.6, 0.58},
