@@ -6,6 +6,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <limits>
@@ -121,6 +122,38 @@ TEST(SympatheticStrings, ExclusionKeepsTheBalance) {
   EXPECT_TRUE(body.strings().excluded(51));
   EXPECT_EQ(body.strings().keyEnergy(51), 0.0);
   EXPECT_LT(worst, 1e-12 * scale);
+}
+
+// A body prepared again after keys left the coupling steps exactly as a fresh one: the runs of
+// coupled keys the strings step are found anew (every key is coupled after prepare()).
+TEST(SympatheticStrings, PreparedAgainStepsAsAFreshBody) {
+  const std::vector<SympatheticKey> keys = grandSympatheticKeys();
+  PianoBody reused = preparedBody(keys);
+  for (int k = 0; k < reused.keys(); ++k) reused.setDamper(k, 0.0);
+  for (int k = 10; k < 80; ++k) reused.setExcluded(k, true);  // runs: 0–9 and 80–87
+  std::vector<double> f(reused.keys(), 0.0);
+  for (int n = 0; n < 500; ++n) {
+    f[5] = std::sin(0.02 * n);
+    reused.step(f);
+  }
+  reused.prepare({}, bridgeLine(21, 108, SoundboardPhysics{}), keys);
+  PianoBody fresh = preparedBody(keys);
+  for (PianoBody* body : {&reused, &fresh})
+    for (int k = 0; k < body->keys(); ++k) body->setDamper(k, 0.0);
+  std::fill(f.begin(), f.end(), 0.0);
+  for (int n = 0; n < 2000; ++n) {
+    f[39] = n < 1000 ? 20.0 * std::sin(2 * kPi * 261.6 * n / kRate) : 0.0;
+    reused.step(f);
+    fresh.step(f);
+  }
+  EXPECT_GT(fresh.strings().keyEnergy(45), 0.0);  // a key the old runs left out rings
+  EXPECT_EQ(reused.strings().keyEnergy(45), fresh.strings().keyEnergy(45));
+  EXPECT_EQ(reused.energy(), fresh.energy());
+  double l = 0.0, r = 0.0, lf = 0.0, rf = 0.0;
+  reused.output(l, r);
+  fresh.output(lf, rf);
+  EXPECT_EQ(l, lf);
+  EXPECT_EQ(r, rf);
 }
 
 struct CoupledMode {
