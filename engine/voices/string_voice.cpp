@@ -81,6 +81,36 @@ double gaugeShift(const StringPatch& patch, const NonlinearString& string, doubl
   return epsilon;
 }
 
+// The damper's felt on u's grid: the nodes under it (at least the nearest, at most kPointDampers
+// spread evenly over it), and the resistance each needs for the fundamental to gain
+// ln(1000)/damper_t60_s of decay rate:
+//   r = σ ρA L / Σ_m sin²(π x_m/L)                                                     (D2)
+struct Felt {
+  std::array<Eigen::Index, SplitSav<HammeredString>::kPointDampers> nodes{};
+  int count = 0;
+  double resistance = 0.0;  // kg/s at each node, full contact
+};
+
+Felt feltUnder(const StringPatch& patch, const NonlinearString& string) {
+  const int segments = string.segments();
+  const double length = string.physics().length;
+  auto node = [&](double x) {
+    return std::clamp<Eigen::Index>(std::lround(x / length * segments) - 1, 0, segments - 2);
+  };
+  const Eigen::Index first = node(patch.damperPosition * length),
+                     last = node(patch.damperPosition * length + patch.damperWidth);
+  Felt felt;
+  felt.count = static_cast<int>(
+      std::min<Eigen::Index>(last - first + 1, static_cast<Eigen::Index>(felt.nodes.size())));
+  double shape = 0.0;
+  for (int m = 0; m < felt.count; ++m) {
+    felt.nodes[m] = felt.count == 1 ? first : first + (last - first) * m / (felt.count - 1);
+    shape += std::pow(std::sin(std::numbers::pi * (felt.nodes[m] + 1) / segments), 2);
+  }
+  felt.resistance = kLn1000 / patch.damperT60 * string.physics().linearDensity() * length / shape;
+  return felt;
+}
+
 }  // namespace
 
 StringLoss stringLossFromT60(const StringPhysics& string, double t60Low, double t60High,
@@ -161,26 +191,7 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
   require(patch.damperWidth >= 0.0 && patch.damperWidth <= 0.1, "damper_width_m", patch.damperWidth,
           "between 0 and 0.1 m");
   NonlinearString string(tuned.physics, tuned.grid);
-  // The nodes of u's grid under the felt (at least the nearest, at most kPointDampers spread
-  // evenly over it), and the resistance each needs for the fundamental to gain
-  // ln(1000)/damper_t60_s of decay rate:
-  //   r = σ ρA L / Σ_m sin²(π x_m/L)                                                   (D2)
-  const int segments = string.segments();
-  const double length = tuned.physics.length;
-  auto feltNode = [&](double x) {
-    return std::clamp<Eigen::Index>(std::lround(x / length * segments) - 1, 0, segments - 2);
-  };
-  const Eigen::Index first = feltNode(patch.damperPosition * length),
-                     last = feltNode(patch.damperPosition * length + patch.damperWidth);
-  constexpr int kMost = SplitSav<HammeredString>::kPointDampers;
-  const int feltNodes = static_cast<int>(std::min<Eigen::Index>(last - first + 1, kMost));
-  std::array<Eigen::Index, kMost> felt{};
-  double shape = 0.0;
-  for (int m = 0; m < feltNodes; ++m) {
-    felt[m] = feltNodes == 1 ? first : first + (last - first) * m / (feltNodes - 1);
-    shape += std::pow(std::sin(std::numbers::pi * (felt[m] + 1) / segments), 2);
-  }
-  const double feltR = kLn1000 / patch.damperT60 * tuned.physics.linearDensity() * length / shape;
+  const Felt felt = feltUnder(patch, string);
   // The uniform damper has no felt, nor a key without a damper (kNoDamperT60).
   const bool hasFelt = patch.feltDamper && patch.damperT60 < kNoDamperT60;
   const double epsilon = gaugeShift(patch, string, k);
@@ -201,9 +212,9 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
   patch_ = patch;
   sampleRate_ = sampleRate;
   k_ = k;
-  feltNode_ = felt;
-  feltNodes_ = hasFelt ? feltNodes : 0;
-  feltR_ = feltR;
+  feltNode_ = felt.nodes;
+  feltNodes_ = hasFelt ? felt.count : 0;
+  feltR_ = felt.resistance;
   loss_ = loss;
   fundamental_ = schemePartial(system.string(), k, 1);
   bendOffset_ = system.string().transverseEigenvalue(1, 0.0);
