@@ -8,7 +8,8 @@
 namespace hamiltone {
 
 namespace {
-constexpr int kCheckEvery = 256;  // steps between looks for quiet damped keys
+constexpr int kCheckEvery = 256;     // steps between looks for quiet damped keys
+constexpr double kWakeFloors = 4.0;  // a sleeping key wakes at this many floors (below)
 }  // namespace
 
 void PianoBody::prepare(const PianoBodySpec& spec, std::span<const BoardPoint> bridgePoints,
@@ -50,21 +51,35 @@ void PianoBody::step(std::span<const double> bridgeForces) noexcept {
 #pragma omp simd reduction(+ : after)
   for (int k = 0; k < n; ++k) after += fs[k] * wNext[k];
   supplied_ += board_.lastWork() - 0.5 * (after - before);
-  if (++sinceCheck_ == kCheckEvery) sleepQuietKeys();
+  if (++sinceCheck_ == kCheckEvery) sleepAndWakeKeys();
 }
 
-void PianoBody::sleepQuietKeys() noexcept {
+// A damped key is quiet when its strings ring with less than the floor and the board at its point
+// holds less than the floor in their spring (½ κ_k w², what they would follow statically): then
+// its coupling does nothing the floor would notice, and it sleeps. A sleeping damped key's point
+// is read again (one row of Φ) and the key wakes, at rest on the board, once the board moves it
+// past kWakeFloors floors (twice the w it slept at: keys at the floor do not flip at every look).
+// Without the wake, keys asleep before a note's wave reached the bridge stayed out for good, and
+// the board missed their load.
+void PianoBody::sleepAndWakeKeys() noexcept {
   sinceCheck_ = 0;
   const Eigen::VectorXd& w = board_.displacements();
   const Eigen::VectorXd& wPrev = board_.previousDisplacements();
   const double floor = std::max(quietFloor_, quietRelative_ * energy());
   bool changed = false;
-  for (int key = 0; key < keys(); ++key)
-    if (strings_.coupled(key) && strings_.damped(key) &&
-        strings_.ringingEnergy(key, w[key], wPrev[key]) < floor) {
+  for (int key = 0; key < keys(); ++key) {
+    if (!strings_.damped(key) || strings_.excluded(key)) continue;
+    if (strings_.asleep(key)) {
+      board_.refreshPoint(key);
+      if (strings_.followingEnergy(key, w[key]) < kWakeFloors * floor) continue;
+      switched_ -= strings_.wake(key, w[key], wPrev[key]);
+      changed = true;
+    } else if (strings_.ringingEnergy(key, w[key], wPrev[key]) < floor &&
+               strings_.followingEnergy(key, w[key]) < floor) {
       switched_ -= strings_.sleep(key, w[key], wPrev[key]);
       changed = true;
     }
+  }
   if (changed) updateActivePoints();
 }
 
@@ -84,10 +99,19 @@ void PianoBody::setDamper(int key, double contact) noexcept {
   }
 }
 
+// A voice taking a key is about to drive the board: every sleeping damped key wakes, at rest on
+// it, before the wave arrives — waiting for the next look (up to 256 steps) would leave the board
+// without their load through the first milliseconds of the note.
 void PianoBody::setExcluded(int key, bool excluded) noexcept {
   board_.refreshPoint(key);  // it may have been asleep, out of use
   switched_ -= strings_.setExcluded(key, excluded, board_.displacement(key),
                                     board_.previousDisplacements()[key]);
+  for (int other = 0; excluded && other < keys(); ++other) {
+    if (!strings_.asleep(other) || strings_.excluded(other)) continue;
+    board_.refreshPoint(other);
+    switched_ -=
+        strings_.wake(other, board_.displacement(other), board_.previousDisplacements()[other]);
+  }
   updateActivePoints();
 }
 

@@ -39,9 +39,11 @@ class PianoBody {
   void setExcluded(int key, bool excluded) noexcept;
   // Points in use: where the board computes w, the keys whose strings are coupled. A step costs
   // modes × (points in use + points driven) for the board's two products, and the coupled keys'
-  // partials. Every 256 steps a key whose damper is on and whose strings ring (about the shape the
-  // bridge gives them) with less than the floor (J) sleeps — it leaves the coupling, booked like an
-  // exclusion — until its damper lifts. Keys without dampers never sleep. The floor is the larger
+  // partials. Every 256 steps a key whose damper is on, whose strings ring (about the shape the
+  // bridge gives them) with less than the floor (J) and which the board moves by less than the
+  // floor (½ κ_k w²) sleeps — it leaves the coupling, booked like an exclusion — until the board
+  // moves it past the floor again or its damper lifts. Keys without dampers never sleep. The floor
+  // is the larger
   // of `joules` and `relative` times the body's energy: damped strings still ring a little while
   // the voices drive the board (1e-3 to 1e-2 of it each, measured), so only a relative floor lets
   // them sleep then — at the price of that ring.
@@ -66,7 +68,7 @@ class PianoBody {
  private:
   Soundboard board_;
   SympatheticStrings strings_;
-  void sleepQuietKeys() noexcept;
+  void sleepAndWakeKeys() noexcept;
   void updateActivePoints() noexcept;
   Eigen::VectorXd forces_;  // the strings' (Y4), per point
   std::vector<int> active_;

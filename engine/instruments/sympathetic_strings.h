@@ -69,7 +69,8 @@ class SympatheticStrings {
   double setExcluded(int key, bool excluded, double w, double wPrev) noexcept;
   bool excluded(int key) const noexcept { return excluded_[key] != 0; }
   // A damped key gone quiet sleeps: it leaves the coupling like an excluded one, so the board
-  // need not compute w at its point; it wakes, at rest on the board, when its damper lifts.
+  // need not compute w at its point; it wakes, at rest on the board, when the board moves it or
+  // its damper lifts (PianoBody).
   // Both return the jump in H_strings + H_c, J.
   double sleep(int key, double w, double wPrev) noexcept;
   double wake(int key, double w, double wPrev) noexcept;
@@ -90,6 +91,9 @@ class SympatheticStrings {
   // The same of its motion about the bridge's static shape, a_n + C_n w/K̂_n (w, wPrev: w^{n+1},
   // w^n): what rings, not what merely follows the board; J.
   double ringingEnergy(int key, double w, double wPrev) const noexcept;
+  // What its strings hold when they merely follow the board at w, in the static shape: ½ κ_k w²
+  // (κ_k as prepared, coupled or not), J.
+  double followingEnergy(int key, double w) const noexcept { return 0.5 * kappaOn_[key] * w * w; }
 
   int keys() const noexcept { return keys_; }
   int partials(int key) const noexcept { return partials_[key]; }

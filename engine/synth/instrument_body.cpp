@@ -47,10 +47,10 @@ void prepareBody(PianoBody& body, const Instrument& instrument, double sampleRat
   spec.sympatheticMaxHz = std::min(instrument.body.sympatheticMaxHz, 0.24 * sampleRate);
   const std::vector<BoardPoint> points =
       bridgeLine(instrument.lowestNote, instrument.highestNote, spec.board);
-  // Damped keys whose strings have gone quiet sleep out of the coupling (PianoBody): their springs
-  // leave the board. Keeping them all in (setQuietFloor(-1)) changed the pedal's effect at C4
-  // by 0.4 dB and cost three times as much with the pedal up (tests/synth/
-  // synth_body_test.cpp), so they sleep.
+  // Damped keys whose strings have gone quiet while the board is still sleep out of the coupling
+  // (PianoBody) and wake when a voice strikes or the board moves them: the sound is that of every
+  // key kept in (setQuietFloor(-1)) to the floor's share, −65 dB (sympathetic_strings_test.cpp),
+  // and a silent piano costs only its undamped keys.
   body.prepare(spec, points, sympatheticKeys(instrument));
 }
 
