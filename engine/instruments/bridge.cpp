@@ -2,6 +2,7 @@
 #include "instruments/bridge.h"
 
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 
@@ -37,6 +38,8 @@ void Bridge::prepare(const BridgePhysics& p, double k, double addedStiffness) {
           "a finite number >= 0 N/m");
   require(std::isfinite(p.resistance) && p.resistance >= 0.0, "bridge_resistance_kg_s",
           p.resistance, "a finite number >= 0 kg/s");
+  require(p.angle >= 0.0 && p.angle <= kMaxBridgeAngle, "bridge_angle_deg",
+          p.angle * 180.0 / std::numbers::pi, "between 0 and 10 degrees");
   // Störmer–Verlet's bound on the bridge's own row, the strings' K_s included.
   const double stiffest = p.stiffness + addedStiffness;
   require(k * k * stiffest / p.mass < 4.0, "bridge_mass_kg", p.mass,
@@ -52,14 +55,15 @@ void Bridge::prepare(const BridgePhysics& p, double k, double addedStiffness) {
 
 void Bridge::reset() noexcept {
   w0_ = w1_ = 0.0;
-  dissipated_ = 0.0;
+  dissipated_ = supplied_ = 0.0;
 }
 
-double Bridge::step(double force) noexcept {
+double Bridge::step(double force, double drive) noexcept {
   const double next =
-      (2.0 * w1_ - down_ * w0_ + kkOverM_ * (force - physics_.stiffness * w1_)) / up_;
+      (2.0 * w1_ - down_ * w0_ + kkOverM_ * (force + drive - physics_.stiffness * w1_)) / up_;
   const double velocity = (next - w0_) / (2.0 * k_);  // δt· w
   dissipated_ += physics_.resistance * k_ * velocity * velocity;
+  supplied_ += drive * k_ * velocity;  // D^n (w^{n+1} − w^{n−1})/2
   w0_ = w1_;
   w1_ = next;
   return next;

@@ -3,15 +3,25 @@
 // strings' scheme (38) and the bridge together exactly energy-conserving.
 #pragma once
 
+#include <numbers>
+
 #include "instruments/string.h"
 #include "schemes/hamiltonian.h"
 
 namespace hamiltone {
 
+// The largest angle α a bridge takes: 10°, five times the steepest downbearing in practice
+// (docs/instrument-data.md §3.7); the reaction the drive neglects grows as sin²α.
+inline constexpr double kMaxBridgeAngle = 10.0 * std::numbers::pi / 180.0;
+
 struct BridgePhysics {
   double mass = 0.0;        // M_b, kg
   double stiffness = 0.0;   // K_b, N/m
   double resistance = 0.0;  // R_b, kg/s (N per m/s)
+  // α, rad: the angle between the speaking length and the board's plane where it crosses the
+  // bridge (its share of the downbearing, docs/instrument-data.md §3.7). The string's tension
+  // change ΔT then pushes the bridge towards the board by ΔT sin α: its longitudinal end force.
+  double angle = 0.0;
 };
 
 // The string's end u_M = w rides on the bridge (moving simply supported end: D2 u = 0 there).
@@ -51,11 +61,16 @@ class BridgeCoupling {
   double c1_ = 0.0, c2_ = 0.0, self_ = 0.0;
 };
 
-// M_b δtt w = −K_b w^n − R_b δt· w + F^n, the resistance centred (as σ0 in (49)):
-//   w^{n+1} = (2 w^n − (1 − R_b k/2M_b) w^{n−1} + (k²/M_b)(F^n − K_b w^n)) / (1 + R_b k/2M_b),
-// H^{n+½} = ½ M_b (δ₊w)² + ½ K_b w^{n+1} w^n, H^{n+½} − H^{n−½} = F^n (w^{n+1} − w^{n−1})/2
-// − R_b k (δt· w)². Levels as the scheme's: after a step it holds w^n and w^{n+1}; the strings'
-// next step takes w^{n+1}, current(), and so does the force of the bridge's next step.
+// M_b δtt w = −K_b w^n − R_b δt· w + F^n + D^n, the resistance centred (as σ0 in (49)):
+//   w^{n+1} = (2 w^n − (1 − R_b k/2M_b) w^{n−1} + (k²/M_b)(F^n + D^n − K_b w^n))
+//             / (1 + R_b k/2M_b),
+// H^{n+½} = ½ M_b (δ₊w)² + ½ K_b w^{n+1} w^n, H^{n+½} − H^{n−½} = (F^n + D^n)(w^{n+1} − w^{n−1})/2
+// − R_b k (δt· w)². F is the strings' transverse pull, whose work the coupling E_c returns to them;
+// D a drive from outside that balance — the strings' longitudinal end force through the angle α,
+// which the strings do not feel back (w does not enter their V': a neglected reaction of order
+// EA sin²α / L, some 50 N/m against the bridges' 1e5 to 7e5) — its work tallied in supplied().
+// Levels as the scheme's: after a step it holds w^n and w^{n+1}; the strings' next step takes
+// w^{n+1}, current(), and so does the force of the bridge's next step.
 class Bridge {
  public:
   // Throws std::invalid_argument naming the field if a value is not finite and >= 0 (mass > 0),
@@ -65,11 +80,13 @@ class Bridge {
   void reset() noexcept;
 
   double current() const { return w1_; }  // w at the level the next steps' forces use
-  // One step under the force F (the strings' pull, at level current()). Returns w^{n+1}.
-  double step(double force) noexcept;
+  // One step under the force F (the strings' pull, at level current()) and the drive D. Returns
+  // w^{n+1}.
+  double step(double force, double drive = 0.0) noexcept;
 
   double energy() const;  // H^{n+½} of the bridge alone
   double dissipated() const { return dissipated_; }
+  double supplied() const { return supplied_; }  // the drives' work since reset(), J
   // What the bridge passes on to the soundboard at the last level: K_b w + R_b ẇ.
   double forceOnBoard() const;
   const BridgePhysics& physics() const { return physics_; }
@@ -78,7 +95,7 @@ class Bridge {
   BridgePhysics physics_;
   double k_ = 0.0, up_ = 1.0, down_ = 1.0, kkOverM_ = 0.0;
   double w0_ = 0.0, w1_ = 0.0;  // w^n, w^{n+1}
-  double dissipated_ = 0.0;
+  double dissipated_ = 0.0, supplied_ = 0.0;
 };
 
 }  // namespace hamiltone

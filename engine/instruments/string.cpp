@@ -189,6 +189,7 @@ double NonlinearString::singleGridGradient(const Vector& q, Vector& grad) const 
   padded(q.data() + (m - 1), m, vp);
   const double sum = kernels_->singleGridForces(up, vp, m, 1.0 / h_, c, work1_.data(),
                                                 work2_.data(), grad.data(), grad.data() + (m - 1));
+  endTension_ = (physics_.tension * (vp[m] - vp[m - 1]) + work2_[m - 1]) / h_;
   return 0.5 * c * sum;
 }
 
@@ -232,6 +233,7 @@ double NonlinearString::twoGridGradient(const Vector& q, Vector& grad) const {
   double* gv = grad.data() + (m - 1);
   const double invHv = 1.0 / hv_;
   for (Eigen::Index j = 0; j < mv - 1; ++j) gv[j] = (we[j] - we[j + 1]) * invHv;
+  endTension_ = physics_.tension * eta[mv - 1] + we[mv - 1] * invHv;
   return 0.5 * hv_ * (physics_.young * physics_.area - physics_.tension) * sum;
 }
 

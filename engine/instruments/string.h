@@ -61,6 +61,11 @@ class NonlinearString {
   double stiffnessEigenvalueMax() const;
   double splitPotential(const Vector& q) const;
   double splitGradient(const Vector& q, Vector& grad) const;
+  // The string's pull along its axis on its far end (x = L, where a bridge sits) beyond the static
+  // T0, at the q of the last splitGradient() — in a scheme's step, q^n: with v_M the end's
+  // longitudinal displacement (held at 0), ΔT = ∂(½ qᵀKq + V')/∂v_M = T0 η_M + (1/h_v) ∂V'/∂η_M,
+  // η_M the last coarse strain. On a string stretched uniformly by ε it is EA ε (Hooke).
+  double endTension() const { return endTension_; }
 
   // M(−L)(a − b), L = D2 on u and on v: the operator of the frequency-dependent loss σ1. `out`
   // must not be `a` or `b`.
@@ -95,6 +100,7 @@ class NonlinearString {
   double h_, hv_;         // h_u, h_v
   Vector inverseMass_;
   double tensionScale_ = 1.0, tensionScaleMax_ = 1.0;
+  mutable double endTension_ = 0.0;
   // Work of the stencils and the gradient: per fine segment (size Mu; work3_ holds u padded with
   // its fixed ends, Mu + 1; scratch_ the two-grid kernels', 4 Mu) and per coarse cell (Mv).
   mutable Vector work1_, work2_, work3_, cell1_, cell2_, cell3_;

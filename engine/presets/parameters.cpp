@@ -186,6 +186,17 @@ constexpr Parameter kTable[] = {
      .perKey = true,
      .doc = "The bridge's resistance, where the strings' energy leaves for the soundboard: "
             "unisons in phase drain n times faster than alone (the prompt sound)."},
+    {.name = "bridge.angle_deg",
+     .unit = "degrees",
+     .min = 0,
+     .max = 10,
+     .defaultText = "0",
+     .model = kString,
+     .perKey = true,
+     .doc = "Angle of the speaking length to the board where it crosses the bridge (its share of "
+            "the downbearing, docs/instrument-data.md §3.7): the strings' tension change pushes "
+            "the bridge by sin(angle) of it, bringing their longitudinal end force — the phantom "
+            "partials and longitudinal modes — to the board. 0: the transverse end force alone."},
 
     {.name = "body.enabled",
      .type = boolean,

@@ -45,6 +45,7 @@ constexpr VoiceField kStringFields[] = {
     {"sympathetic maxHz", "body.sympathetic_max_Hz"},
     {"bridge_stiffness_N_m", "bridge.stiffness_N_m"},
     {"bridge_resistance_kg_s", "bridge.resistance_kg_s"},
+    {"bridge_angle_deg", "bridge.angle_deg"},
     {"hammer stiffness", "hammer.stiffness_N_per_m_p"},
     {"hammer exponent", "hammer.exponent"},
     {"hammer position", "hammer.position"},
@@ -119,7 +120,8 @@ void buildStringKeys(const PresetValues& values, Instrument& instrument) {
     key.detuneCents = at("string.detune_cents");
     key.bridge = {.mass = at("bridge.mass_kg"),
                   .stiffness = at("bridge.stiffness_N_m"),
-                  .resistance = at("bridge.resistance_kg_s")};
+                  .resistance = at("bridge.resistance_kg_s"),
+                  .angle = at("bridge.angle_deg") * std::numbers::pi / 180.0};
     instrument.keys.push_back(key);
   }
 }

@@ -25,6 +25,7 @@ void UnisonStrings::prepare(const Instrument& instrument, int note, double sampl
   }
   strings_ = std::move(strings);
   bridge_ = bridge;
+  sinAngle_ = std::sin(key.bridge.angle);
   bridged_ = bridged;
   for (auto* buffer : {&boardForce_, &scratchLeft_, &scratchRight_})
     buffer->assign(std::max(maxBlock, 1), 0.0f);
@@ -89,7 +90,7 @@ double UnisonStrings::energy() const {
 double UnisonStrings::injectedEnergy() const {
   double e = 0.0;
   for (const StringVoice& s : strings_) e += s.injectedEnergy();
-  return e;
+  return bridged_ ? e + bridge_.supplied() : e;
 }
 
 void UnisonStrings::process(std::span<float> left, std::span<float> right) noexcept {
@@ -115,7 +116,9 @@ void UnisonStrings::process(std::span<float> left, std::span<float> right) noexc
 }
 
 // Per output sample, R scheme steps; each step: every string takes the bridge's w^n, then the
-// bridge takes their pull at q^n (bridge.h). The guard and the quiet check act on the key.
+// bridge takes their pull at q^n and, through sin α, their tension change there (bridge.h). w and
+// u are positive away from the board (the hammer's way), so a tighter string presses the bridge
+// down: the drive is −ΔT sin α. The guard and the quiet check act on the key.
 void UnisonStrings::processBridged(std::span<float> left, std::span<float> right) noexcept {
   const size_t n = left.size();
   const bool stereo = channels() == 2;
@@ -134,16 +137,17 @@ void UnisonStrings::processBridged(std::span<float> left, std::span<float> right
     int steps = 0;
     for (bool ready = false; !ready;) {
       const double w = bridge_.current();
-      double pull = 0.0;
+      double pull = 0.0, tension = 0.0;
       for (StringVoice& s : strings_) {
         double out[2] = {0.0, 0.0};
         ready = s.stepOnBridge(w, out);
         sum[0] += out[0];
         sum[1] += out[1];
         pull += s.pullOnBridge(w);
+        tension += s.endTension();
       }
       wBefore_ = w;
-      bridge_.step(pull);
+      bridge_.step(pull, -sinAngle_ * tension);
       force += bridge_.forceOnBoard();
       ++steps;
     }

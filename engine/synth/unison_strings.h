@@ -45,13 +45,16 @@ class UnisonStrings {
   std::span<StringVoice> strings() { return strings_; }
   // Strings, bridge and coupling: H^{n+½} less the losses' share, J (the guard's, the tests').
   double energy() const;
-  double injectedEnergy() const;  // by the strikes and the bend, all strings
+  // By the strikes and the bend, all strings, and on a bridge the work of their longitudinal end
+  // force on it (Bridge::supplied()).
+  double injectedEnergy() const;
 
  private:
   void processBridged(std::span<float> left, std::span<float> right) noexcept;
 
   std::vector<StringVoice> strings_;
   Bridge bridge_;
+  double sinAngle_ = 0.0;  // sin α of the bridge: the share of the tension change that pushes it
   bool bridged_ = false, active_ = false;  // active_: the bridged key's, as one voice
   int guardEvents_ = 0;
   QuietDetector quiet_;  // the bridged key's, on its summed output

@@ -102,6 +102,8 @@ class StringVoice {
   void wake() noexcept;
   bool stepOnBridge(double w, double out[2]) noexcept;
   double pullOnBridge(double w) const noexcept { return coupling_.forceOnBridge(scheme_->q(), w); }
+  // The string's tension change at its bridge end at q^n, N (NonlinearString::endTension()).
+  double endTension() const noexcept { return scheme_->system().string().endTension(); }
   const BridgeCoupling& coupling() const { return coupling_; }
   const StringPatch& patch() const { return patch_; }
   // The nodes of u (coordinates of q) under a felt damper; none with the uniform one or none.

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <vector>
 
@@ -32,6 +33,7 @@ struct BridgedStrings {
   std::vector<SplitSav<HammeredString>> strings;
   std::vector<BridgeCoupling> couplings;
   Bridge bridge;
+  double sinAngle = 0.0;  // the bridge's angle α: the strings' tension change drives it
 
   BridgedStrings(const std::vector<StringPhysics>& physics, StringGrid grid, StepParameters params,
                  const BridgePhysics& bridgePhysics, const std::vector<Vector>& start) {
@@ -46,6 +48,7 @@ struct BridgedStrings {
       added += couplings.back().selfStiffness();
     }
     bridge.prepare(bridgePhysics, params.k, added);
+    sinAngle = std::sin(bridgePhysics.angle);
   }
 
   void strike(size_t s, double speed) {
@@ -56,17 +59,20 @@ struct BridgedStrings {
     scheme.resetPsi(1);
   }
 
-  void step() {
+  // Returns the strings' summed tension change at the bridge, N.
+  double step() {
     const double w = bridge.current();
-    double pull = 0.0;
+    double pull = 0.0, tension = 0.0;
     for (size_t s = 0; s < strings.size(); ++s) {
       const BridgeCoupling& c = couplings[s];
       strings[s].setPointForce(0, c.lastIndex(), c.forceOnLast(w));
       strings[s].setPointForce(1, c.secondIndex(), c.forceOnSecond(w));
       strings[s].step();
       pull += c.forceOnBridge(strings[s].q(), w);
+      tension += strings[s].system().string().endTension();
     }
-    bridge.step(pull);
+    bridge.step(pull, -sinAngle * tension);
+    return tension;
   }
 
   // H^{n+½} of everything, and what the losses took.
@@ -120,6 +126,64 @@ TEST(BridgedStrings, CoupledEnergyIsConservedToRoundoff) {
   EXPECT_LT(worst, 1e-11 * start);
 }
 
+// With the bridge at an angle the strings' tension change drives it too, from outside the coupled
+// balance (bridge.h): H + what the losses took − what the drive gave is constant to roundoff.
+TEST(BridgedStrings, TheLongitudinalDriveKeepsTheBalanceWithItsWork) {
+  const StepParameters params{.k = kStep, .sigma1 = 2e-5, .epsilon = 0.01};
+  const std::vector<StringPhysics> physics{c3(759.0), c3(760.0), c3(758.2)};
+  const StringGrid grid = gridFor(physics[0], params.sigma1);
+  BridgedStrings key(physics, grid, params,
+                     {.mass = 0.02, .stiffness = 2e5, .resistance = 40.0, .angle = 0.1}, {});
+  for (size_t s = 0; s < 3; ++s) key.strike(s, 4.0 + s);
+  double w = key.bridge.current();
+  key.step();
+  const double start = key.energy(w) + key.dissipated() - key.bridge.supplied();
+  double worst = 0.0, pulled = 0.0;
+  for (int n = 0; n < 4800; ++n) {
+    w = key.bridge.current();
+    pulled = std::max(pulled, std::abs(key.step()));
+    worst =
+        std::max(worst, std::abs(key.energy(w) + key.dissipated() - key.bridge.supplied() - start));
+  }
+  EXPECT_GT(pulled, 1.0);                                    // N: the strings pull hard
+  EXPECT_GT(std::abs(key.bridge.supplied()), 1e-9 * start);  // and the drive does work
+  EXPECT_LT(worst, 1e-11 * start);
+}
+
+// The longitudinal precursor: a struck string's tension change reaches the bridge at c_L =
+// sqrt(E/ρ), some 15 times sooner than its transverse wave (at c_T = sqrt(T0/ρA)). With the bridge
+// at an angle it moves within the longitudinal travel time, (1 − x0/L) L / c_L plus a coarse
+// cell's worth; on a level bridge it stays exactly still until the transverse disturbance gets
+// there, which on the stiff string's explicit scheme is the stencil's reach, two fine cells a step
+// (the stiff string's fastest, shortest waves: still five times later).
+TEST(BridgedStrings, TheLongitudinalPulseReachesTheBridgeBeforeTheTransverseWave) {
+  const StepParameters params{.k = kStep, .epsilon = 0.01};
+  const StringPhysics p = c3();
+  const StringGrid grid = gridFor(p, 0.0);
+  const BridgePhysics level{.mass = 0.02, .stiffness = 2e5, .resistance = 40.0};
+  BridgePhysics tilted = level;
+  tilted.angle = 1.0 * std::numbers::pi / 180.0;
+  const double distance = (1.0 - HammerFelt{}.position) * p.length;
+  const double cL = std::sqrt(p.young / p.density);
+  const double cT = std::sqrt(p.tension / p.linearDensity());
+  const double cell = p.length / grid.longitudinal;
+  auto firstMotion = [&](const BridgePhysics& bridge) {
+    BridgedStrings key({p}, grid, params, bridge, {});
+    key.strike(0, 4.0);
+    for (int n = 0; n < static_cast<int>(0.01 * kRate); ++n) {
+      key.step();
+      if (key.bridge.current() != 0.0) return n * kStep;
+    }
+    return 1.0;
+  };
+  const double longitudinal = firstMotion(tilted), transverse = firstMotion(level);
+  std::printf("bridge moves after %.3f ms tilted, %.3f ms level; L/c_L %.3f ms, L/c_T %.3f ms\n",
+              1e3 * longitudinal, 1e3 * transverse, 1e3 * distance / cL, 1e3 * distance / cT);
+  EXPECT_LT(longitudinal, (distance + cell) / cL);
+  EXPECT_GE(transverse, std::floor(distance / (2.0 * p.length / grid.transverse)) * kStep);
+  EXPECT_GT(transverse, 4.0 * longitudinal);
+}
+
 // Measured amplitude decay rate of the string energy's envelope between t0 and t1.
 template <class Run>
 double decayRate(Run&& run, double t0, double t1) {
@@ -138,6 +202,32 @@ Vector firstMode(const NonlinearString& s, double amplitude) {
   for (Eigen::Index j = 0; j < u.size(); ++j)
     u[j] = amplitude * std::sin(std::numbers::pi * (j + 1) / s.segments());
   return u;
+}
+
+// The tension change is quadratic in the transverse amplitude (the longitudinal motion is driven
+// by the square of the slope; Etchenique, Collin & Moore 2015 measured it so, docs/instrument-
+// data.md §3.7): a string started in its first mode at twice the amplitude pulls on the bridge
+// four times as hard, to the order of the slope squared (~1e-5 here).
+TEST(BridgedStrings, TheTensionChangeIsQuadraticInTheAmplitude) {
+  const StepParameters params{.k = kStep, .epsilon = 0.01};
+  const StringPhysics p = c3();
+  const StringGrid grid = gridFor(p, 0.0);
+  const NonlinearString probe(p, grid);
+  const BridgePhysics tilted{.mass = 0.02, .stiffness = 2e5, .resistance = 40.0, .angle = 0.02};
+  auto rms = [&](double amplitude) {
+    BridgedStrings key({p}, grid, params, tilted, {firstMode(probe, amplitude)});
+    double sum = 0.0;
+    const int steps = static_cast<int>(0.01 * kRate);
+    for (int n = 0; n < steps; ++n) {
+      const double t = key.step();
+      sum += t * t;
+    }
+    return std::sqrt(sum / steps);
+  };
+  const double small = rms(1e-3), large = rms(2e-3);
+  std::printf("tension change RMS %.4g N at 1 mm, %.4g N at 2 mm: ratio %.5f\n", small, large,
+              large / small);
+  EXPECT_NEAR(large / small, 4.0, 4.0 * 1e-3);
 }
 
 // A lossless string on a bridge that is nearly a pure resistance R (ωM ≪ R, no spring): each
@@ -218,6 +308,14 @@ TEST(Bridge, RefusesAMassTooLightForTheExplicitCoupling) {
                std::invalid_argument);
   EXPECT_THROW(b.prepare({.mass = 1.0, .stiffness = 0.0, .resistance = NAN}, kStep, 0.0),
                std::invalid_argument);
+  for (double angle : {-0.01, 0.2, double(NAN)}) {  // rad; 0.2 rad is 11.5°, past the 10° allowed
+    try {
+      b.prepare({.mass = 1.0, .stiffness = 0.0, .resistance = 1.0, .angle = angle}, kStep, 0.0);
+      FAIL() << "a bridge angle of " << angle << " rad was accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("bridge_angle_deg"), std::string::npos) << e.what();
+    }
+  }
 }
 
 }  // namespace

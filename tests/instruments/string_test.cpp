@@ -84,6 +84,27 @@ TEST(NonlinearString, TwoGridPotentialAveragesTheStrainOverEachCell) {
               1e-12 * single.splitPotential(qs));
 }
 
+// Hooke at the end: u at rest and v rising by ε0 h_v a cell up to the last node, the end held at
+// 0, so the last cell falls back: η_M = −ε0 (Mv − 1). With u at rest every s_l = 1 + η_J, so ε_J
+// = η_J, and the pull on the far end is T0 η_M + (EA − T0) ε_M (1 + η_M)/(1 + η_M) = EA η_M:
+// Hooke's law with the last cell's strain, on either grid.
+TEST(NonlinearString, EndTensionIsHookesLawOfTheLastCell) {
+  const StringPhysics p = c3();
+  const double ea = p.young * p.area;
+  for (const StringGrid grid : {StringGrid{24, 24}, StringGrid{24, 6}}) {
+    const NonlinearString string(p, grid);
+    Vector q = Vector::Zero(string.size());
+    const double eps0 = 3e-5, hv = string.longitudinalSpacing();
+    const int mv = grid.longitudinal;
+    for (int j = 1; j < mv; ++j) q[grid.transverse - 1 + j - 1] = eps0 * j * hv;
+    Vector grad(string.size());
+    string.splitGradient(q, grad);
+    const double last = -eps0 * (mv - 1);  // η_M = (0 − v_{M−1}) / h_v
+    EXPECT_NEAR(string.endTension(), ea * last, 1e-9 * ea * std::abs(last))
+        << "Mu = " << grid.transverse << ", Mv = " << mv;
+  }
+}
+
 // Mv = 1 leaves no longitudinal unknown: V' = (EA − T0) L ε² / 2 with ε = (ℓ − L)/L, ℓ the discrete
 // length of the string, and the force on u is that of the extra tension (EA − T0) ε along each
 // segment: ∂V'/∂ζ_l = h (EA − T0) ε ζ_l / s_l — Kirchhoff–Carrier's tension from the mean strain,
@@ -106,6 +127,11 @@ TEST(NonlinearString, OneCellIsTheKirchhoffCarrierString) {
   const double expected = 0.5 * ea * p.length * strain * strain;
   Vector grad(string.size());
   EXPECT_NEAR(string.splitGradient(q, grad), expected, 1e-9 * expected);
+  // The pull on the end: the extra tension along the last segment, (EA − T0) ε mean(1/s_l) — the
+  // whole string's, as Kirchhoff–Carrier's tension is the same everywhere.
+  double meanInverse = 0.0;
+  for (int l = 0; l < mu; ++l) meanInverse += 1.0 / (s[l] * mu);
+  EXPECT_NEAR(string.endTension(), ea * strain * meanInverse, 1e-9 * ea * strain);
   for (int j = 0; j < mu - 1; ++j) {  // D₋ᵀ of the segment forces
     const double force = ea * strain * (zeta[j] / s[j] - zeta[j + 1] / s[j + 1]);
     EXPECT_NEAR(grad[j], force, 1e-9 * ea * strain) << j;
