@@ -10,8 +10,8 @@
 
 namespace hamiltone {
 
-// The largest angle α a bridge takes: 10°, five times the steepest downbearing in practice
-// (docs/instrument-data.md §3.7); the reaction the drive neglects grows as sin²α.
+// The largest angle α a bridge takes: 10°, nearly seven times the steepest downbearing quoted in
+// docs/instrument-data.md §3.7 (1½°); the reaction the drive neglects grows as sin²α.
 inline constexpr double kMaxBridgeAngle = 10.0 * std::numbers::pi / 180.0;
 
 struct BridgePhysics {
@@ -68,7 +68,8 @@ class BridgeCoupling {
 // − R_b k (δt· w)². F is the strings' transverse pull, whose work the coupling E_c returns to them;
 // D a drive from outside that balance — the strings' longitudinal end force through the angle α,
 // which the strings do not feel back (w does not enter their V': a neglected reaction of order
-// EA sin²α / L, some 50 N/m against the bridges' 1e5 to 7e5) — its work tallied in supplied().
+// EA sin²α / L, 40 to 400 N/m a string at 1° from bass to treble, against the bridges' 1e5 to
+// 7e5) — its work tallied in supplied().
 // Levels as the scheme's: after a step it holds w^n and w^{n+1}; the strings' next step takes
 // w^{n+1}, current(), and so does the force of the bridge's next step.
 class Bridge {

@@ -2,6 +2,7 @@
 #include "instruments/piano_body.h"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -10,6 +11,10 @@ namespace hamiltone {
 namespace {
 constexpr int kCheckEvery = 256;     // steps between looks for quiet damped keys
 constexpr double kWakeFloors = 4.0;  // a sleeping key wakes at this many floors (below)
+// After a strike no key sleeps for this long (s): the struck string's wave reaches the board only
+// after its travel along the string (A0's: 16 ms, from the hammer to the bridge at c_T), and keys
+// that slept before it came would wake only at the next look after it.
+constexpr double kAwakeAfterStrikeS = 0.05;
 }  // namespace
 
 void PianoBody::prepare(const PianoBodySpec& spec, std::span<const BoardPoint> bridgePoints,
@@ -19,6 +24,7 @@ void PianoBody::prepare(const PianoBodySpec& spec, std::span<const BoardPoint> b
                    spec.sympatheticMaxPartials);
   forces_.setZero(board_.points());
   active_.reserve(board_.points());
+  awakeSteps_ = static_cast<int>(std::lround(kAwakeAfterStrikeS * spec.sampleRate));
   reset();
 }
 
@@ -28,6 +34,7 @@ void PianoBody::reset() noexcept {
   updateActivePoints();
   supplied_ = switched_ = 0.0;
   sinceCheck_ = 0;
+  awakeLeft_ = 0;
 }
 
 void PianoBody::step(std::span<const double> bridgeForces) noexcept {
@@ -51,16 +58,18 @@ void PianoBody::step(std::span<const double> bridgeForces) noexcept {
 #pragma omp simd reduction(+ : after)
   for (int k = 0; k < n; ++k) after += fs[k] * wNext[k];
   supplied_ += board_.lastWork() - 0.5 * (after - before);
+  if (awakeLeft_ > 0) --awakeLeft_;
   if (++sinceCheck_ == kCheckEvery) sleepAndWakeKeys();
 }
 
-// A damped key is quiet when its strings ring with less than the floor and the board at its point
-// holds less than the floor in their spring (½ κ_k w², what they would follow statically): then
-// its coupling does nothing the floor would notice, and it sleeps. A sleeping damped key's point
-// is read again (one row of Φ) and the key wakes, at rest on the board, once the board moves it
-// past kWakeFloors floors (twice the w it slept at: keys at the floor do not flip at every look).
-// Without the wake, keys asleep before a note's wave reached the bridge stayed out for good, and
-// the board missed their load.
+// A damped key is quiet when its strings ring with less than the floor and would hold less than
+// the floor following the board at its point in their static shape (½ U T0/L w²): then its
+// coupling does nothing the floor would notice, and it sleeps — but not within
+// kAwakeAfterStrikeS of a strike. A sleeping damped key's w is read again (two gathers of Φ) and
+// the key wakes, at rest on the board, once that energy passes kWakeFloors floors (twice the w
+// of the sleep threshold: keys at the threshold do not flip at every look). Without the wake, keys
+// asleep before a note's wave reached the bridge stayed out for good, and the board missed their
+// load.
 void PianoBody::sleepAndWakeKeys() noexcept {
   sinceCheck_ = 0;
   const Eigen::VectorXd& w = board_.displacements();
@@ -74,7 +83,7 @@ void PianoBody::sleepAndWakeKeys() noexcept {
       if (strings_.followingEnergy(key, w[key]) < kWakeFloors * floor) continue;
       switched_ -= strings_.wake(key, w[key], wPrev[key]);
       changed = true;
-    } else if (strings_.ringingEnergy(key, w[key], wPrev[key]) < floor &&
+    } else if (awakeLeft_ == 0 && strings_.ringingEnergy(key, w[key], wPrev[key]) < floor &&
                strings_.followingEnergy(key, w[key]) < floor) {
       switched_ -= strings_.sleep(key, w[key], wPrev[key]);
       changed = true;
@@ -100,8 +109,7 @@ void PianoBody::setDamper(int key, double contact) noexcept {
 }
 
 // A voice taking a key is about to drive the board: every sleeping damped key wakes, at rest on
-// it, before the wave arrives — waiting for the next look (up to 256 steps) would leave the board
-// without their load through the first milliseconds of the note.
+// it, and none sleeps for kAwakeAfterStrikeS — time for the struck string's wave to arrive.
 void PianoBody::setExcluded(int key, bool excluded) noexcept {
   board_.refreshPoint(key);  // it may have been asleep, out of use
   switched_ -= strings_.setExcluded(key, excluded, board_.displacement(key),
@@ -112,6 +120,7 @@ void PianoBody::setExcluded(int key, bool excluded) noexcept {
     switched_ -=
         strings_.wake(other, board_.displacement(other), board_.previousDisplacements()[other]);
   }
+  if (excluded) awakeLeft_ = awakeSteps_;
   updateActivePoints();
 }
 

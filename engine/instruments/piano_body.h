@@ -35,18 +35,19 @@ class PianoBody {
   void setDamper(int key, double contact) noexcept;
   // A key a voice is playing: its sympathetic strings leave the coupling; the energy they take
   // away (or bring back) is booked in dissipated(), so the balance holds across the switch. The
-  // voice drives its point through step()'s forces.
+  // voice drives its point through step()'s forces. Excluding a key (a strike) also wakes every
+  // sleeping key and keeps them all awake for 50 ms, while the struck string's wave travels.
   void setExcluded(int key, bool excluded) noexcept;
   // Points in use: where the board computes w, the keys whose strings are coupled. A step costs
   // modes × (points in use + points driven) for the board's two products, and the coupled keys'
   // partials. Every 256 steps a key whose damper is on, whose strings ring (about the shape the
-  // bridge gives them) with less than the floor (J) and which the board moves by less than the
-  // floor (½ κ_k w²) sleeps — it leaves the coupling, booked like an exclusion — until the board
-  // moves it past the floor again or its damper lifts. Keys without dampers never sleep. The floor
-  // is the larger
-  // of `joules` and `relative` times the body's energy: damped strings still ring a little while
-  // the voices drive the board (1e-3 to 1e-2 of it each, measured), so only a relative floor lets
-  // them sleep then — at the price of that ring.
+  // bridge gives them) with less than the floor (J) and would hold less than the floor following
+  // the board in their static shape (½ U T0/L w²) sleeps — it leaves the coupling, booked like an
+  // exclusion — until the board moves it past four floors or its damper lifts. Keys without
+  // dampers never sleep. The floor is the larger of `joules` and `relative` times the body's
+  // energy: damped strings still ring a little while the voices drive the board (1e-3 to 1e-2 of
+  // it each, measured), so only a relative floor lets them sleep then — at the price of that
+  // ring.
   void setQuietFloor(double joules, double relative = 0.0) noexcept {
     quietFloor_ = joules;
     quietRelative_ = relative;
@@ -75,6 +76,7 @@ class PianoBody {
   double supplied_ = 0.0, switched_ = 0.0;
   double quietFloor_ = 1e-12, quietRelative_ = 0.0;
   int sinceCheck_ = 0;
+  int awakeSteps_ = 0, awakeLeft_ = 0;  // no key sleeps for awakeLeft_ more steps (a strike)
 };
 
 }  // namespace hamiltone

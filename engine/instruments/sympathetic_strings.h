@@ -91,9 +91,12 @@ class SympatheticStrings {
   // The same of its motion about the bridge's static shape, a_n + C_n w/K̂_n (w, wPrev: w^{n+1},
   // w^n): what rings, not what merely follows the board; J.
   double ringingEnergy(int key, double w, double wPrev) const noexcept;
-  // What its strings hold when they merely follow the board at w, in the static shape: ½ κ_k w²
-  // (κ_k as prepared, coupled or not), J.
-  double followingEnergy(int key, double w) const noexcept { return 0.5 * kappaOn_[key] * w * w; }
+  // What its strings hold when they merely follow the board at w, in the static shape u = w x/L:
+  // ½ U T0/L w², J.
+  double followingEnergy(int key, double w) const noexcept {
+    const SympatheticKey& s = data_[key];
+    return 0.5 * s.unisons * s.tension / s.length * w * w;
+  }
 
   int keys() const noexcept { return keys_; }
   int partials(int key) const noexcept { return partials_[key]; }

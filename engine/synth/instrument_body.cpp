@@ -47,10 +47,11 @@ void prepareBody(PianoBody& body, const Instrument& instrument, double sampleRat
   spec.sympatheticMaxHz = std::min(instrument.body.sympatheticMaxHz, 0.24 * sampleRate);
   const std::vector<BoardPoint> points =
       bridgeLine(instrument.lowestNote, instrument.highestNote, spec.board);
-  // Damped keys whose strings have gone quiet while the board is still sleep out of the coupling
+  // Damped keys whose strings have gone quiet, where the board is still, sleep out of the coupling
   // (PianoBody) and wake when a voice strikes or the board moves them: the sound is that of every
-  // key kept in (setQuietFloor(-1)) to the floor's share, −65 dB (sympathetic_strings_test.cpp),
-  // and a silent piano costs only its undamped keys.
+  // key kept in (setQuietFloor(-1)) but for the floor's share (−54 dB for C4 after silence in
+  // sympathetic_strings_test.cpp, −51 dB for A0 struck hard in the synth), at the cost of the keys
+  // the board moves.
   body.prepare(spec, points, sympatheticKeys(instrument));
 }
 

@@ -90,7 +90,7 @@ double UnisonStrings::energy() const {
 double UnisonStrings::injectedEnergy() const {
   double e = 0.0;
   for (const StringVoice& s : strings_) e += s.injectedEnergy();
-  return bridged_ ? e + bridge_.supplied() : e;
+  return e;
 }
 
 void UnisonStrings::process(std::span<float> left, std::span<float> right) noexcept {

@@ -45,8 +45,9 @@ class UnisonStrings {
   std::span<StringVoice> strings() { return strings_; }
   // Strings, bridge and coupling: H^{n+½} less the losses' share, J (the guard's, the tests').
   double energy() const;
-  // By the strikes and the bend, all strings, and on a bridge the work of their longitudinal end
-  // force on it (Bridge::supplied()).
+  // By the strikes and the bend, all strings. Not the work of their longitudinal end force on the
+  // bridge (Bridge::supplied(), −46 dB of a note at 1°): the guard does not excuse growth fed by
+  // that one-way drive.
   double injectedEnergy() const;
 
  private:

@@ -167,19 +167,30 @@ TEST(BridgedStrings, TheLongitudinalPulseReachesTheBridgeBeforeTheTransverseWave
   const double cL = std::sqrt(p.young / p.density);
   const double cT = std::sqrt(p.tension / p.linearDensity());
   const double cell = p.length / grid.longitudinal;
+  bool towardsBoard = false;  // w < 0: u and w are positive away from the board
   auto firstMotion = [&](const BridgePhysics& bridge) {
     BridgedStrings key({p}, grid, params, bridge, {});
     key.strike(0, 4.0);
     for (int n = 0; n < static_cast<int>(0.01 * kRate); ++n) {
       key.step();
-      if (key.bridge.current() != 0.0) return n * kStep;
+      if (key.bridge.current() != 0.0) {
+        towardsBoard = key.bridge.current() < 0.0;
+        return n * kStep;
+      }
     }
     return 1.0;
   };
-  const double longitudinal = firstMotion(tilted), transverse = firstMotion(level);
-  std::printf("bridge moves after %.3f ms tilted, %.3f ms level; L/c_L %.3f ms, L/c_T %.3f ms\n",
-              1e3 * longitudinal, 1e3 * transverse, 1e3 * distance / cL, 1e3 * distance / cT);
+  const double longitudinal = firstMotion(tilted);
+  const bool tiltedTowardsBoard = towardsBoard;
+  const double transverse = firstMotion(level);
+  towardsBoard = tiltedTowardsBoard;
+  std::printf(
+      "bridge moves after %.3f ms tilted (first towards the board: %s), %.3f ms level; "
+      "(1 - x0/L) L/c_L %.3f ms, /c_T %.3f ms\n",
+      1e3 * longitudinal, towardsBoard ? "yes" : "no", 1e3 * transverse, 1e3 * distance / cL,
+      1e3 * distance / cT);
   EXPECT_LT(longitudinal, (distance + cell) / cL);
+  EXPECT_TRUE(towardsBoard);  // the strike stretches the string: it presses the bridge down
   EXPECT_GE(transverse, std::floor(distance / (2.0 * p.length / grid.transverse)) * kStep);
   EXPECT_GT(transverse, 4.0 * longitudinal);
 }
@@ -207,7 +218,7 @@ Vector firstMode(const NonlinearString& s, double amplitude) {
 // The tension change is quadratic in the transverse amplitude (the longitudinal motion is driven
 // by the square of the slope; Etchenique, Collin & Moore 2015 measured it so, docs/instrument-
 // data.md §3.7): a string started in its first mode at twice the amplitude pulls on the bridge
-// four times as hard, to the order of the slope squared (~1e-5 here).
+// four times as hard, to a part in a thousand (the higher orders of the amplitude).
 TEST(BridgedStrings, TheTensionChangeIsQuadraticInTheAmplitude) {
   const StepParameters params{.k = kStep, .epsilon = 0.01};
   const StringPhysics p = c3();
