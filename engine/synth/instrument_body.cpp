@@ -50,8 +50,8 @@ void prepareBody(PianoBody& body, const Instrument& instrument, double sampleRat
   // Damped keys whose strings have gone quiet, where the board is still, sleep out of the coupling
   // (PianoBody) and wake when a voice strikes or the board moves them: the sound is that of every
   // key kept in (setQuietFloor(-1)) but for the floor's share (−54 dB for C4 after silence in
-  // sympathetic_strings_test.cpp, −51 dB for A0 struck hard in the synth), at the cost of the keys
-  // the board moves.
+  // sympathetic_strings_test.cpp; A0 struck hard in the synth renders the same bits), at the cost
+  // of the keys the board moves.
   body.prepare(spec, points, sympatheticKeys(instrument));
 }
 

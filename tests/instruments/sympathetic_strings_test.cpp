@@ -260,10 +260,11 @@ TEST(SympatheticStrings, KeysAsleepBeforeANoteWakeWhenItsWaveArrives) {
   EXPECT_LT(db, -40.0);
 }
 
-// A board driven steadily at A0's point after silence, no key struck: the keys it moves wake at
-// the next look and stay awake while it moves them — a key that follows the board does not sleep
-// because it hardly rings (the following energy keeps it in), so the points in use settle and do
-// not flip from look to look.
+// A board driven steadily at A0's point after silence (5 N at 55 Hz), no key struck: the keys it
+// moves wake and, at this drive, stay awake — a key that follows the board does not sleep because
+// it hardly rings (the following energy keeps it in), so the points in use settle and do not flip
+// from look to look. (w is read at one instant: a key near the threshold could still sleep at a
+// zero crossing; here none is.)
 TEST(SympatheticStrings, KeysTheBoardMovesStayAwake) {
   PianoBody body = preparedBody(grandSympatheticKeys());
   for (int k = 0; k < body.keys(); ++k) body.setDamper(k, 1.0);
