@@ -102,10 +102,16 @@ void PianoBody::updateActivePoints() noexcept {
 void PianoBody::setDamper(int key, double contact) noexcept {
   strings_.setDamper(key, contact);
   if (strings_.asleep(key) && !strings_.damped(key)) {
-    board_.refreshPoint(key);
-    switched_ -= strings_.wake(key, board_.displacement(key), board_.previousDisplacements()[key]);
+    wakeAtRest(key);
     updateActivePoints();
   }
+}
+
+// A sleeping key back in the coupling, at rest on the board where it is now: its point, out of
+// use while it slept, is read again first; the jump in energy is booked.
+void PianoBody::wakeAtRest(int key) noexcept {
+  board_.refreshPoint(key);
+  switched_ -= strings_.wake(key, board_.displacement(key), board_.previousDisplacements()[key]);
 }
 
 // A voice taking a key is about to drive the board: every sleeping damped key wakes, at rest on
@@ -114,12 +120,8 @@ void PianoBody::setExcluded(int key, bool excluded) noexcept {
   board_.refreshPoint(key);  // it may have been asleep, out of use
   switched_ -= strings_.setExcluded(key, excluded, board_.displacement(key),
                                     board_.previousDisplacements()[key]);
-  for (int other = 0; excluded && other < keys(); ++other) {
-    if (!strings_.asleep(other) || strings_.excluded(other)) continue;
-    board_.refreshPoint(other);
-    switched_ -=
-        strings_.wake(other, board_.displacement(other), board_.previousDisplacements()[other]);
-  }
+  for (int other = 0; excluded && other < keys(); ++other)
+    if (strings_.asleep(other) && !strings_.excluded(other)) wakeAtRest(other);
   if (excluded) awakeLeft_ = awakeSteps_;
   updateActivePoints();
 }

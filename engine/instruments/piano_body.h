@@ -70,6 +70,7 @@ class PianoBody {
   Soundboard board_;
   SympatheticStrings strings_;
   void sleepAndWakeKeys() noexcept;
+  void wakeAtRest(int key) noexcept;
   void updateActivePoints() noexcept;
   Eigen::VectorXd forces_;  // the strings' (Y4), per point
   std::vector<int> active_;

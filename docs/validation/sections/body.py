@@ -240,11 +240,9 @@ def run(ctx):
 
 
 def band_db(x, rate, lo, hi):
-    """Power in [lo, hi) Hz of the whole take, Hann-windowed, dB."""
-    w = np.hanning(len(x))
-    f = np.fft.rfftfreq(len(x), 1 / rate)
-    p = np.abs(np.fft.rfft(x * w)) ** 2
-    return 10 * np.log10(np.sum(p[(f >= lo) & (f < hi)]) + 1e-30)
+    """Power in [lo, hi) Hz of the whole take (common.spectrum, not padded), dB."""
+    f, mag = spectrum(x, rate, 0.0, len(x) / rate + 1.0, pad=1)  # the slice stops at the end
+    return 10 * np.log10(np.sum(mag[(f >= lo) & (f < hi)] ** 2) + 1e-30)
 
 
 def longitudinal_force(ctx):
