@@ -49,10 +49,12 @@ NonlinearString::NonlinearString(const StringPhysics& p, StringGrid grid)
   inverseMass_.resize(nu + nv);
   inverseMass_.head(nu).setConstant(1.0 / (p.linearDensity() * h_));
   inverseMass_.tail(nv).setConstant(1.0 / (p.linearDensity() * hv_));
-  for (Vector* w : {&work1_, &work2_}) w->setZero(grid.transverse);
-  work3_.setZero(grid.transverse + 1);
+  // The two grids' kernels run in whole vector registers past the last segment (kernels.h).
+  work1_.setZero(grid.transverse + kMaxLanes);
+  work2_.setZero(grid.transverse);
+  work3_.setZero(grid.transverse + kMaxLanes);
   for (Vector* w : {&cell1_, &cell2_, &cell3_}) w->setZero(grid.longitudinal);
-  scratch_.setZero(4 * grid.transverse);
+  scratch_.setZero(2 * (grid.transverse + kMaxLanes));
 }
 
 void NonlinearString::applyStiffness(const Vector& q, Vector& out) const {

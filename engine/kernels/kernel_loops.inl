@@ -8,54 +8,65 @@
 namespace hamiltone::HAMILTONE_KERNEL_NS {
 namespace {
 
+constexpr int kLanes = HAMILTONE_KERNEL_LANES;
+static_assert(kLanes <= kMaxLanes);
+
+// Cell by cell, in chunks of one vector register: a cell's last chunk runs past its r segments
+// into the next cell's (or the padding's), and the next cell writes those values again. The loop of
+// one chunk has a fixed trip count, so it is one vector iteration; a loop of r = 8…11 would not
+// vectorise, nor would one over the whole grid without spreading each η_J over its r segments
+// first. Cell J's sums come after cell J + 1's chunks, whose square roots and divisions then run
+// while the sums' chain of additions waits on J's.
 HAMILTONE_TARGET void cellStretches(const double* up, const double* eta, long mv, int r,
                                     double invH, double* scratch, double* zetaOverS, double* strain,
                                     double* sumInverse) {
   const long m = mv * r;
-  double* a = scratch;
-  double* b = scratch + m;
-  double* excess = scratch + 2 * m;
-  double* inverse = scratch + 3 * m;
-  for (long j = 0; j < mv; ++j) {
-    const double aj = (1.0 + eta[j]) * (1.0 + eta[j]), bj = 2.0 * eta[j] + eta[j] * eta[j];
-#pragma omp simd
-    for (int l = 0; l < r; ++l) a[j * r + l] = aj, b[j * r + l] = bj;
-  }
-  // One loop over the whole fine grid, which vectorises (a loop per cell of r = 8…11 does not).
-#pragma omp simd
-  for (long l = 0; l < m; ++l) {
-    const double zeta = (up[l + 1] - up[l]) * invH, z2 = zeta * zeta;
-    const double stretch = __builtin_sqrt(a[l] + z2);
-    const double t = 1.0 / (stretch * (stretch + 1.0));  // one division for all three
-    const double inv = (stretch + 1.0) * t;
-    excess[l] = (b[l] + z2) * stretch * t;
-    inverse[l] = inv;
-    zetaOverS[l] = zeta * inv;
-  }
+  double* excess = scratch;
+  double* inverse = scratch + m + kMaxLanes;
   const double invR = 1.0 / r;
-  for (long j = 0; j < mv; ++j) {
-    double e = 0.0, i = 0.0;
-    for (int l = 0; l < r; ++l) {
-      e += excess[j * r + l];
-      i += inverse[j * r + l];
+  for (long j = 0; j <= mv; ++j) {
+    if (j < mv) {
+      const double aj = (1.0 + eta[j]) * (1.0 + eta[j]), bj = 2.0 * eta[j] + eta[j] * eta[j];
+      for (long t = j * r; t < (j + 1) * r; t += kLanes) {
+#pragma omp simd
+        for (int i = 0; i < kLanes; ++i) {
+          const long l = t + i;
+          const double zeta = (up[l + 1] - up[l]) * invH, z2 = zeta * zeta;
+          const double stretch = __builtin_sqrt(aj + z2);
+          const double d = 1.0 / (stretch * (stretch + 1.0));  // one division for all three
+          const double inv = (stretch + 1.0) * d;
+          excess[l] = (bj + z2) * stretch * d;
+          inverse[l] = inv;
+          zetaOverS[l] = zeta * inv;
+        }
+      }
     }
-    strain[j] = e * invR;
-    sumInverse[j] = i;
+    if (j > 0) {  // cell j − 1, its sums in order of l: the same bits on every path
+      double e = 0.0, i = 0.0;
+      for (long l = (j - 1) * r; l < j * r; ++l) {
+        e += excess[l];
+        i += inverse[l];
+      }
+      strain[j - 1] = e * invR;
+      sumInverse[j - 1] = i;
+    }
   }
 }
 
 HAMILTONE_TARGET void fineForces(long mv, int r, double c, double invH, const double* strain,
                                  double* scratch, const double* zetaOverS, double* gu) {
   const long m = mv * r;
-  double* w = scratch;
+  double* w = scratch;  // ∂V'/∂ζ_l = c ε_J ζ_l/s_l, in the chunks of cellStretches
   for (long j = 0; j < mv; ++j) {
     const double wj = c * strain[j];
+    const long first = j * r;
+    for (int t = 0; t < r; t += kLanes) {
 #pragma omp simd
-    for (int l = 0; l < r; ++l) w[j * r + l] = wj;
+      for (int i = 0; i < kLanes; ++i) w[first + t + i] = zetaOverS[first + t + i] * wj;
+    }
   }
 #pragma omp simd
-  for (long l = 0; l < m - 1; ++l)
-    gu[l] = (zetaOverS[l] * w[l] - zetaOverS[l + 1] * w[l + 1]) * invH;
+  for (long l = 0; l < m - 1; ++l) gu[l] = (w[l] - w[l + 1]) * invH;
 }
 
 HAMILTONE_TARGET double singleGridForces(const double* up, const double* vp, long m, double invH,
@@ -153,8 +164,9 @@ HAMILTONE_TARGET double savUpdateOf(long n, const double* g, const double* q, co
     double b = 2.0 * q[i] - down * qm[i];
     if constexpr (stiff) b -= kk * (minv[i] * kq[i]);
     if constexpr (extra) b -= minv[i] * (xScale * x[i]);
-    qp[i] = (b + c * (minv[i] * g[i])) * invUp;
-    sdq += g[i] * (qp[i] - qm[i]);
+    const double next = (b + c * (minv[i] * g[i])) * invUp;  // not read back from qp
+    qp[i] = next;
+    sdq += g[i] * (next - qm[i]);
   }
   return sdq;
 }
@@ -172,7 +184,6 @@ HAMILTONE_TARGET double savUpdate(long n, const double* g, const double* q, cons
 
 // One vector register of doubles (GCC's vector extension, so that the product below is vectorised
 // along the rows as written, whatever the compiler's cost model).
-constexpr int kLanes = HAMILTONE_KERNEL_LANES;
 typedef double Lanes __attribute__((vector_size(kLanes * sizeof(double))));
 
 HAMILTONE_TARGET void matrixProduct(const double* a, long lda, const double* b, long ldb,

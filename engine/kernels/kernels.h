@@ -11,6 +11,7 @@
 namespace hamiltone {
 
 enum class Isa { portable, avx2, avx512 };
+constexpr int kMaxLanes = 8;  // doubles in the widest vector register (AVX-512)
 
 struct Kernels {
   Isa isa;
@@ -19,10 +20,12 @@ struct Kernels {
   // η_J the coarse strains, each fine segment's s_l = sqrt((1 + η_J)² + ζ_l²), ζ_l = (up[l+1] −
   // up[l]) invH; sets zetaOverS_l = ζ_l/s_l, strain_J = (1/r) Σ_{l∈J} (s_l − 1) (as (b + ζ²)/(s +
   // 1), b = 2η + η²: no cancellation at small strain) and sumInverse_J = Σ_{l∈J} 1/s_l.
-  // scratch: 4 m doubles.
+  // The loops run in whole vector registers past the last segment: up holds m + kMaxLanes values
+  // (finite: zeros past the end), zetaOverS m + kMaxLanes; scratch: 2 (m + kMaxLanes) doubles.
   void (*cellStretches)(const double* up, const double* eta, long mv, int r, double invH,
                         double* scratch, double* zetaOverS, double* strain, double* sumInverse);
-  // ∇_u V' = D₋ᵀ(c strain_J ζ_l/s_l): gu_l = (w_l − w_{l+1}) invH, l < m − 1. scratch: m doubles.
+  // ∇_u V' = D₋ᵀ(c strain_J ζ_l/s_l): gu_l = (w_l − w_{l+1}) invH, l < m − 1, zetaOverS as
+  // cellStretches left it. scratch: m + kMaxLanes doubles.
   void (*fineForces)(long mv, int r, double c, double invH, const double* strain, double* scratch,
                      const double* zetaOverS, double* gu);
   // One grid (BDZ (65)): with up, vp the padded u and v (m + 1 values), ζ_l, η_l their strains

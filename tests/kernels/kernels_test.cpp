@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <stdexcept>
@@ -57,21 +58,45 @@ TEST(Kernels, StencilsAndStretchesAreBitIdenticalOnEveryPath) {
       base.secondDifferenceOfDifference(a.data(), b.data(), x.data(), n, 2.1);
       path->secondDifferenceOfDifference(a.data(), b.data(), y.data(), n, 2.1);
       EXPECT_EQ(x, y) << path->name << " n = " << n;
-      // The two grids' strains and forces, r = 3 fine segments a cell, strains η ~ 1e-4.
-      const long mv = n, m = 3 * mv;
-      const std::vector<double> up = randomArray(m + 1, 1e-3, 9), eta = randomArray(mv, 1e-4, 10);
-      std::vector<double> scratch(4 * m), z1(m), s1(mv), i1(mv), z2(m), s2(mv), i2(mv), g1(m - 1),
-          g2(m - 1);
-      base.cellStretches(up.data(), eta.data(), mv, 3, 100.0, scratch.data(), z1.data(), s1.data(),
-                         i1.data());
-      path->cellStretches(up.data(), eta.data(), mv, 3, 100.0, scratch.data(), z2.data(), s2.data(),
-                          i2.data());
-      EXPECT_EQ(z1, z2) << path->name;
-      EXPECT_EQ(s1, s2) << path->name;
-      EXPECT_EQ(i1, i2) << path->name;
-      base.fineForces(mv, 3, 7.0, 100.0, s1.data(), scratch.data(), z1.data(), g1.data());
-      path->fineForces(mv, 3, 7.0, 100.0, s1.data(), scratch.data(), z1.data(), g2.data());
-      EXPECT_EQ(g1, g2) << path->name;
+      // The two grids' strains and forces, r fine segments a cell (the chunks of one register
+      // ending inside a cell, on its edge, or r = 1), strains η ~ 1e-4, the arrays as the kernels
+      // ask (kernels.h): u padded with zeros, room for the last register. The portable path gives
+      // the bits of the formulas written out here, every path those of the portable one.
+      for (int r : {1, 3, 8, 11}) {
+        const long mv = n, m = r * mv;
+        std::vector<double> up = randomArray(m + 1, 1e-3, 9);
+        up.front() = up[m] = 0.0;
+        up.resize(m + kMaxLanes, 0.0);
+        const std::vector<double> eta = randomArray(mv, 1e-4, 10);
+        std::vector<double> zeta(m), strain(mv), sumInverse(mv), grad(m - 1);
+        for (long j = 0; j < mv; ++j) {
+          const double aj = (1.0 + eta[j]) * (1.0 + eta[j]), bj = 2.0 * eta[j] + eta[j] * eta[j];
+          double e = 0.0, i = 0.0;
+          for (long l = j * r; l < (j + 1) * r; ++l) {
+            const double z = (up[l + 1] - up[l]) * 100.0, s = std::sqrt(aj + z * z);
+            const double d = 1.0 / (s * (s + 1.0));
+            e += (bj + z * z) * s * d;
+            i += (s + 1.0) * d;
+            zeta[l] = z * ((s + 1.0) * d);
+          }
+          strain[j] = e * (1.0 / r);
+          sumInverse[j] = i;
+        }
+        for (long l = 0; l + 1 < m; ++l)
+          grad[l] =
+              (zeta[l] * (7.0 * strain[l / r]) - zeta[l + 1] * (7.0 * strain[(l + 1) / r])) * 100.0;
+        for (const Kernels* k : {&base, path}) {
+          std::vector<double> scratch(2 * (m + kMaxLanes), NAN), z(m + kMaxLanes, NAN), s(mv),
+              i(mv), g(m - 1);
+          k->cellStretches(up.data(), eta.data(), mv, r, 100.0, scratch.data(), z.data(), s.data(),
+                           i.data());
+          EXPECT_TRUE(std::equal(zeta.begin(), zeta.end(), z.begin())) << k->name << " r " << r;
+          EXPECT_EQ(s, strain) << k->name << " r = " << r;
+          EXPECT_EQ(i, sumInverse) << k->name << " r = " << r;
+          k->fineForces(mv, r, 7.0, 100.0, s.data(), scratch.data(), z.data(), g.data());
+          EXPECT_EQ(g, grad) << k->name << " r = " << r;
+        }
+      }
       // One grid: u and v padded, m = n + 1 segments; the forces bit for bit, the sum reordered.
       const std::vector<double> upS = randomArray(n + 2, 1e-3, 12),
                                 vp = randomArray(n + 2, 1e-4, 11);

@@ -1,0 +1,162 @@
+// The string's nonlinear kernels per fine segment, on each instruction set this CPU runs, beside
+// the floor they cannot go under: every segment needs one square root (s_l) and one division (the
+// two grids' 1/(s_l (s_l + 1)), which gives 1/s_l and s_l − 1 by products), or two divisions on
+// the single grid. The floor loops do only that arithmetic over the same number of values, so the
+// summary says how far above it each kernel runs — the bound on the two grids' cost ratio (the
+// fine grid has as many segments as the transverse one, SCHEMES §3b).
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "kernels/kernels.h"
+#include "recording_reporter.h"
+
+namespace hamiltone {
+namespace {
+
+// A0 of grand-piano at 48 kHz: two grids 43 cells of 8 fine segments, one grid 318 segments.
+constexpr long kCells = 43;
+constexpr int kRatio = 8;
+constexpr long kFine = kCells * kRatio;
+constexpr long kSingle = 318;
+
+// Values of a given scale that vary from one index to the next without a pattern the timing
+// could depend on.
+std::vector<double> wiggle(long n, double scale, double step) {
+  std::vector<double> a(n);
+  for (long i = 0; i < n; ++i) a[i] = scale * std::sin(step * static_cast<double>(i * i % 97));
+  return a;
+}
+
+benchmark::Counter perSegment(double segments) {
+  return benchmark::Counter(
+      segments, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+
+// The padded displacement of a struck string (mm over a grid of cm): strains of ~1e-3.
+std::vector<double> paddedU(long m) {
+  std::vector<double> up = wiggle(m + kMaxLanes, 1e-5, 0.7);
+  up.front() = 0.0;
+  for (long l = m; l < m + kMaxLanes; ++l) up[l] = 0.0;
+  return up;
+}
+
+void twoGrids(benchmark::State& state, Isa isa) {
+  const Kernels& k = kernelsFor(isa);
+  const std::vector<double> up = paddedU(kFine), eta = wiggle(kCells, 1e-4, 1.3);
+  std::vector<double> scratch(2 * (kFine + kMaxLanes)), zetaOverS(kFine + kMaxLanes),
+      strain(kCells), sumInverse(kCells), gu(kFine);
+  for (auto _ : state) {
+    k.cellStretches(up.data(), eta.data(), kCells, kRatio, 100.0, scratch.data(), zetaOverS.data(),
+                    strain.data(), sumInverse.data());
+    k.fineForces(kCells, kRatio, 7.0, 100.0, strain.data(), scratch.data(), zetaOverS.data(),
+                 gu.data());
+    benchmark::DoNotOptimize(gu.data());
+    benchmark::ClobberMemory();
+  }
+  state.counters["t/segment"] = perSegment(kFine);
+}
+
+void singleGrid(benchmark::State& state, Isa isa) {
+  const Kernels& k = kernelsFor(isa);
+  const std::vector<double> up = paddedU(kSingle), vp = wiggle(kSingle + 1, 1e-6, 1.9);
+  std::vector<double> wz(kSingle), we(kSingle), gu(kSingle), gv(kSingle);
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(k.singleGridForces(up.data(), vp.data(), kSingle, 100.0, 7.0,
+                                                wz.data(), we.data(), gu.data(), gv.data()));
+    benchmark::ClobberMemory();
+  }
+  state.counters["t/segment"] = perSegment(kSingle);
+}
+
+// The floors, compiled like the AVX2 kernels (x86-64-v3): what the hardware's divider does alone.
+#if defined(__x86_64__)
+#define FLOOR_TARGET __attribute__((target("arch=x86-64-v3")))
+#else
+#define FLOOR_TARGET
+#endif
+
+FLOOR_TARGET void sqrtAndDivisions(const double* x, double* y, long n, int divisions) {
+  if (divisions == 1) {
+#pragma omp simd
+    for (long l = 0; l < n; ++l) {
+      const double s = __builtin_sqrt(x[l]);
+      y[l] = 1.0 / (s * (s + 1.0));
+    }
+    return;
+  }
+#pragma omp simd
+  for (long l = 0; l < n; ++l) {
+    const double s = __builtin_sqrt(x[l]);
+    y[l] = x[l] / (s + 1.0) + 1.0 / s;
+  }
+}
+
+void floorLoop(benchmark::State& state, long n, int divisions) {
+  std::vector<double> x(n), y(n);
+  for (long l = 0; l < n; ++l) x[l] = 1.0 + 1e-3 * static_cast<double>(l % 7);
+  for (auto _ : state) {
+    sqrtAndDivisions(x.data(), y.data(), n, divisions);
+    benchmark::DoNotOptimize(y.data());
+    benchmark::ClobberMemory();
+  }
+  state.counters["t/segment"] = perSegment(static_cast<double>(n));
+}
+
+std::string name(const char* what, Isa isa) {
+  return std::string("Kernel/") + what + "/" +
+         (isa == Isa::portable ? "portable"
+          : isa == Isa::avx2   ? "avx2"
+                               : "avx512");
+}
+
+void registerAll() {
+  for (Isa isa : {Isa::portable, Isa::avx2, Isa::avx512}) {
+    if (!cpuRuns(isa)) continue;
+    benchmark::RegisterBenchmark(name("twoGrids", isa).c_str(), &twoGrids, isa);
+    benchmark::RegisterBenchmark(name("singleGrid", isa).c_str(), &singleGrid, isa);
+  }
+#if defined(__x86_64__)
+  if (cpuRuns(Isa::avx2)) {
+    benchmark::RegisterBenchmark("Floor/sqrtOneDivision/avx2", &floorLoop, kFine, 1);
+    benchmark::RegisterBenchmark("Floor/sqrtTwoDivisions/avx2", &floorLoop, kSingle, 2);
+  }
+#endif
+}
+
+void printSummary(const RecordingReporter& reporter) {
+  auto nsPerSegment = [&](const std::string& n) {
+    const auto* r = reporter.find(n);
+    return r == nullptr ? -1.0 : r->counters.at("t/segment").value * 1e9;
+  };
+  const double floor1 = nsPerSegment("Floor/sqrtOneDivision/avx2");
+  const double floor2 = nsPerSegment("Floor/sqrtTwoDivisions/avx2");
+  const double two = nsPerSegment(name("twoGrids", Isa::avx2));
+  const double one = nsPerSegment(name("singleGrid", Isa::avx2));
+  if (floor1 <= 0.0 || floor2 <= 0.0 || two <= 0.0 || one <= 0.0) return;
+  std::printf(
+      "\nAVX2, ns per fine segment: two grids %.2f (floor: sqrt + 1 division %.2f, %.2fx), "
+      "one grid %.2f (floor: sqrt + 2 divisions %.2f, %.2fx)\n",
+      two, floor1, two / floor1, one, floor2, one / floor2);
+  std::printf(
+      "A0: the two grids' nonlinear step costs %.0f ns over %ld segments, the single grid's %.0f "
+      "over %ld\n",
+      two * kFine, kFine, one * kSingle, kSingle);
+}
+
+}  // namespace
+}  // namespace hamiltone
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  hamiltone::registerAll();
+  hamiltone::RecordingReporter reporter;
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+  hamiltone::printSummary(reporter);
+  benchmark::Shutdown();
+  return 0;
+}
