@@ -11,12 +11,16 @@ namespace {
 constexpr int kLanes = HAMILTONE_KERNEL_LANES;
 static_assert(kLanes <= kMaxLanes);
 
-// Cell by cell, in chunks of one vector register: a cell's last chunk runs past its r segments
-// into the next cell's (or the padding's), and the next cell writes those values again. The loop of
-// one chunk has a fixed trip count, so it is one vector iteration; a loop of r = 8…11 would not
+// Cell by cell, in chunks of kChunk segments: a cell's last chunk runs past its r segments into
+// the following cells' (or the padding's), and they write those values again. The loop of one
+// chunk has a fixed trip count, so it is one vector iteration; a loop of r = 8…17 would not
 // vectorise, nor would one over the whole grid without spreading each η_J over its r segments
-// first. Cell J's sums come after cell J + 1's chunks, whose square roots and divisions then run
-// while the sums' chain of additions waits on J's.
+// first. Four lanes at most, also on AVX-512: a chunk of eight would compute up to 78 % more
+// square roots and divisions than r (r = 9: 16), and those are what the kernel waits on. Cell J's
+// sums come after cell J + 1's chunks, whose square roots and divisions then run while the sums'
+// chain of additions waits on J's.
+constexpr int kChunk = kLanes < 4 ? kLanes : 4;
+
 HAMILTONE_TARGET void cellStretches(const double* up, const double* eta, long mv, int r,
                                     double invH, double* scratch, double* zetaOverS, double* strain,
                                     double* sumInverse) {
@@ -27,9 +31,9 @@ HAMILTONE_TARGET void cellStretches(const double* up, const double* eta, long mv
   for (long j = 0; j <= mv; ++j) {
     if (j < mv) {
       const double aj = (1.0 + eta[j]) * (1.0 + eta[j]), bj = 2.0 * eta[j] + eta[j] * eta[j];
-      for (long t = j * r; t < (j + 1) * r; t += kLanes) {
+      for (long t = j * r; t < (j + 1) * r; t += kChunk) {
 #pragma omp simd
-        for (int i = 0; i < kLanes; ++i) {
+        for (int i = 0; i < kChunk; ++i) {
           const long l = t + i;
           const double zeta = (up[l + 1] - up[l]) * invH, z2 = zeta * zeta;
           const double stretch = __builtin_sqrt(aj + z2);
@@ -60,9 +64,9 @@ HAMILTONE_TARGET void fineForces(long mv, int r, double c, double invH, const do
   for (long j = 0; j < mv; ++j) {
     const double wj = c * strain[j];
     const long first = j * r;
-    for (int t = 0; t < r; t += kLanes) {
+    for (int t = 0; t < r; t += kChunk) {
 #pragma omp simd
-      for (int i = 0; i < kLanes; ++i) w[first + t + i] = zetaOverS[first + t + i] * wj;
+      for (int i = 0; i < kChunk; ++i) w[first + t + i] = zetaOverS[first + t + i] * wj;
     }
   }
 #pragma omp simd

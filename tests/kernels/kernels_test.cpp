@@ -1,6 +1,7 @@
-// The kernels of every instruction set this CPU runs against the portable ones: the stencils, the
-// stretches and the plate's products and grid loops bit for bit (the same IEEE operations in the
-// same order, without contraction), the scheme's sums within their reordering bound, and a struck
+// The kernels of every instruction set this CPU runs against the portable ones: the stencils and
+// the plate's products and grid loops bit for bit (the same IEEE operations in the same order,
+// without contraction), the two grids' stretches against their formulas written out (on the
+// portable path too), the scheme's sums within their reordering bound, and a struck
 // two-grid string on each path conserving energy and staying within roundoff growth of the
 // portable run.
 #include "kernels/kernels.h"
@@ -35,7 +36,7 @@ std::vector<double> randomArray(long n, double scale, unsigned seed) {
   return a;
 }
 
-TEST(Kernels, StencilsAndStretchesAreBitIdenticalOnEveryPath) {
+TEST(Kernels, StencilsAndForcesAreBitIdenticalOnEveryPath) {
   const Kernels& base = kernelsFor(Isa::portable);
   const std::vector<const Kernels*> paths = otherPaths();
   if (paths.empty()) GTEST_SKIP() << "this CPU runs only the portable kernels";
@@ -58,45 +59,6 @@ TEST(Kernels, StencilsAndStretchesAreBitIdenticalOnEveryPath) {
       base.secondDifferenceOfDifference(a.data(), b.data(), x.data(), n, 2.1);
       path->secondDifferenceOfDifference(a.data(), b.data(), y.data(), n, 2.1);
       EXPECT_EQ(x, y) << path->name << " n = " << n;
-      // The two grids' strains and forces, r fine segments a cell (the chunks of one register
-      // ending inside a cell, on its edge, or r = 1), strains η ~ 1e-4, the arrays as the kernels
-      // ask (kernels.h): u padded with zeros, room for the last register. The portable path gives
-      // the bits of the formulas written out here, every path those of the portable one.
-      for (int r : {1, 3, 8, 11}) {
-        const long mv = n, m = r * mv;
-        std::vector<double> up = randomArray(m + 1, 1e-3, 9);
-        up.front() = up[m] = 0.0;
-        up.resize(m + kMaxLanes, 0.0);
-        const std::vector<double> eta = randomArray(mv, 1e-4, 10);
-        std::vector<double> zeta(m), strain(mv), sumInverse(mv), grad(m - 1);
-        for (long j = 0; j < mv; ++j) {
-          const double aj = (1.0 + eta[j]) * (1.0 + eta[j]), bj = 2.0 * eta[j] + eta[j] * eta[j];
-          double e = 0.0, i = 0.0;
-          for (long l = j * r; l < (j + 1) * r; ++l) {
-            const double z = (up[l + 1] - up[l]) * 100.0, s = std::sqrt(aj + z * z);
-            const double d = 1.0 / (s * (s + 1.0));
-            e += (bj + z * z) * s * d;
-            i += (s + 1.0) * d;
-            zeta[l] = z * ((s + 1.0) * d);
-          }
-          strain[j] = e * (1.0 / r);
-          sumInverse[j] = i;
-        }
-        for (long l = 0; l + 1 < m; ++l)
-          grad[l] =
-              (zeta[l] * (7.0 * strain[l / r]) - zeta[l + 1] * (7.0 * strain[(l + 1) / r])) * 100.0;
-        for (const Kernels* k : {&base, path}) {
-          std::vector<double> scratch(2 * (m + kMaxLanes), NAN), z(m + kMaxLanes, NAN), s(mv),
-              i(mv), g(m - 1);
-          k->cellStretches(up.data(), eta.data(), mv, r, 100.0, scratch.data(), z.data(), s.data(),
-                           i.data());
-          EXPECT_TRUE(std::equal(zeta.begin(), zeta.end(), z.begin())) << k->name << " r " << r;
-          EXPECT_EQ(s, strain) << k->name << " r = " << r;
-          EXPECT_EQ(i, sumInverse) << k->name << " r = " << r;
-          k->fineForces(mv, r, 7.0, 100.0, s.data(), scratch.data(), z.data(), g.data());
-          EXPECT_EQ(g, grad) << k->name << " r = " << r;
-        }
-      }
       // One grid: u and v padded, m = n + 1 segments; the forces bit for bit, the sum reordered.
       const std::vector<double> upS = randomArray(n + 2, 1e-3, 12),
                                 vp = randomArray(n + 2, 1e-4, 11);
@@ -109,6 +71,52 @@ TEST(Kernels, StencilsAndStretchesAreBitIdenticalOnEveryPath) {
       EXPECT_EQ(gu1, gu2) << path->name;
       EXPECT_EQ(gv1, gv2) << path->name;
       EXPECT_NEAR(sum1, sum2, (n + 1) * 1.2e-16 * sum1) << path->name;  // all terms >= 0
+    }
+  }
+}
+
+// The two grids' strains and forces, r fine segments a cell (chunks ending inside a cell, on its
+// edge, several cells to a chunk at r = 1), strains η ~ 1e-4, every buffer exactly the size
+// kernels.h asks (u padded with zeros): each path, the portable one too, gives the bits of the
+// formulas written out here, so the same bits on every path.
+TEST(Kernels, TwoGridStrainsAndForcesAreTheFormulasOnEveryPath) {
+  std::vector<const Kernels*> paths = otherPaths();
+  paths.push_back(&kernelsFor(Isa::portable));
+  for (long mv : {1L, 2L, 7L, 64L, 343L}) {
+    for (int r : {1, 3, 8, 11}) {
+      const long m = r * mv;
+      std::vector<double> up = randomArray(m + kMaxLanes, 1e-3, 9);
+      up.front() = 0.0;
+      std::fill(up.begin() + m, up.end(), 0.0);
+      const std::vector<double> eta = randomArray(mv, 1e-4, 10);
+      std::vector<double> zeta(m), strain(mv), sumInverse(mv), grad(m - 1);
+      for (long j = 0; j < mv; ++j) {
+        const double aj = (1.0 + eta[j]) * (1.0 + eta[j]), bj = 2.0 * eta[j] + eta[j] * eta[j];
+        double e = 0.0, i = 0.0;
+        for (long l = j * r; l < (j + 1) * r; ++l) {
+          const double z = (up[l + 1] - up[l]) * 100.0, s = std::sqrt(aj + z * z);
+          const double d = 1.0 / (s * (s + 1.0));
+          e += (bj + z * z) * s * d;
+          i += (s + 1.0) * d;
+          zeta[l] = z * ((s + 1.0) * d);
+        }
+        strain[j] = e * (1.0 / r);
+        sumInverse[j] = i;
+      }
+      for (long l = 0; l + 1 < m; ++l)
+        grad[l] =
+            (zeta[l] * (7.0 * strain[l / r]) - zeta[l + 1] * (7.0 * strain[(l + 1) / r])) * 100.0;
+      for (const Kernels* k : paths) {
+        std::vector<double> scratch(2 * (m + kMaxLanes), NAN), z(m + kMaxLanes, NAN), s(mv), i(mv),
+            g(m - 1);
+        k->cellStretches(up.data(), eta.data(), mv, r, 100.0, scratch.data(), z.data(), s.data(),
+                         i.data());
+        EXPECT_TRUE(std::equal(zeta.begin(), zeta.end(), z.begin())) << k->name << " r " << r;
+        EXPECT_EQ(s, strain) << k->name << " r = " << r << " mv = " << mv;
+        EXPECT_EQ(i, sumInverse) << k->name << " r = " << r << " mv = " << mv;
+        k->fineForces(mv, r, 7.0, 100.0, s.data(), scratch.data(), z.data(), g.data());
+        EXPECT_EQ(g, grad) << k->name << " r = " << r << " mv = " << mv;
+      }
     }
   }
 }
