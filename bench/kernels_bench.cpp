@@ -107,10 +107,7 @@ void floorLoop(benchmark::State& state, long n, int divisions) {
 }
 
 std::string name(const char* what, Isa isa) {
-  return std::string("Kernel/") + what + "/" +
-         (isa == Isa::portable ? "portable"
-          : isa == Isa::avx2   ? "avx2"
-                               : "avx512");
+  return std::string("Kernel/") + what + "/" + kernelsFor(isa).name;
 }
 
 void registerAll() {

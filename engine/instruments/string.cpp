@@ -49,7 +49,7 @@ NonlinearString::NonlinearString(const StringPhysics& p, StringGrid grid)
   inverseMass_.resize(nu + nv);
   inverseMass_.head(nu).setConstant(1.0 / (p.linearDensity() * h_));
   inverseMass_.tail(nv).setConstant(1.0 / (p.linearDensity() * hv_));
-  // The two grids' kernels run in whole vector registers past the last segment (kernels.h).
+  // The two grids' kernels run in whole chunks past the last segment (kernels.h).
   work1_.setZero(grid.transverse + kMaxLanes);
   work2_.setZero(grid.transverse);
   work3_.setZero(grid.transverse + kMaxLanes);

@@ -63,10 +63,9 @@ HAMILTONE_TARGET void fineForces(long mv, int r, double c, double invH, const do
   double* w = scratch;  // ∂V'/∂ζ_l = c ε_J ζ_l/s_l, in the chunks of cellStretches
   for (long j = 0; j < mv; ++j) {
     const double wj = c * strain[j];
-    const long first = j * r;
-    for (int t = 0; t < r; t += kChunk) {
+    for (long t = j * r; t < (j + 1) * r; t += kChunk) {
 #pragma omp simd
-      for (int i = 0; i < kChunk; ++i) w[first + t + i] = zetaOverS[first + t + i] * wj;
+      for (int i = 0; i < kChunk; ++i) w[t + i] = zetaOverS[t + i] * wj;
     }
   }
 #pragma omp simd

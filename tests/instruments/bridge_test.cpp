@@ -167,30 +167,30 @@ TEST(BridgedStrings, TheLongitudinalPulseReachesTheBridgeBeforeTheTransverseWave
   const double cL = std::sqrt(p.young / p.density);
   const double cT = std::sqrt(p.tension / p.linearDensity());
   const double cell = p.length / grid.longitudinal;
-  bool towardsBoard = false;  // w < 0: u and w are positive away from the board
+  // When the bridge first moves (1 s: not within 10 ms), and which way: w < 0, towards the board
+  // (u and w are positive away from it).
+  struct Motion {
+    double time;
+    bool towardsBoard;
+  };
   auto firstMotion = [&](const BridgePhysics& bridge) {
     BridgedStrings key({p}, grid, params, bridge, {});
     key.strike(0, 4.0);
     for (int n = 0; n < static_cast<int>(0.01 * kRate); ++n) {
       key.step();
-      if (key.bridge.current() != 0.0) {
-        towardsBoard = key.bridge.current() < 0.0;
-        return n * kStep;
-      }
+      if (key.bridge.current() != 0.0) return Motion{n * kStep, key.bridge.current() < 0.0};
     }
-    return 1.0;
+    return Motion{1.0, false};
   };
-  const double longitudinal = firstMotion(tilted);
-  const bool tiltedTowardsBoard = towardsBoard;
-  const double transverse = firstMotion(level);
-  towardsBoard = tiltedTowardsBoard;
+  const Motion tiltedFirst = firstMotion(tilted);
+  const double longitudinal = tiltedFirst.time, transverse = firstMotion(level).time;
   std::printf(
       "bridge moves after %.3f ms tilted (first towards the board: %s), %.3f ms level; "
       "(1 - x0/L) L/c_L %.3f ms, /c_T %.3f ms\n",
-      1e3 * longitudinal, towardsBoard ? "yes" : "no", 1e3 * transverse, 1e3 * distance / cL,
-      1e3 * distance / cT);
+      1e3 * longitudinal, tiltedFirst.towardsBoard ? "yes" : "no", 1e3 * transverse,
+      1e3 * distance / cL, 1e3 * distance / cT);
   EXPECT_LT(longitudinal, (distance + cell) / cL);
-  EXPECT_TRUE(towardsBoard);  // the strike stretches the string: it presses the bridge down
+  EXPECT_TRUE(tiltedFirst.towardsBoard);  // the strike stretches the string: it presses down
   EXPECT_GE(transverse, std::floor(distance / (2.0 * p.length / grid.transverse)) * kStep);
   EXPECT_GT(transverse, 4.0 * longitudinal);
 }
