@@ -54,7 +54,7 @@ NonlinearString::NonlinearString(const StringPhysics& p, StringGrid grid)
   work2_.setZero(grid.transverse);
   work3_.setZero(grid.transverse + kMaxLanes);
   for (Vector* w : {&cell1_, &cell2_, &cell3_}) w->setZero(grid.longitudinal);
-  scratch_.setZero(2 * (grid.transverse + kMaxLanes));
+  scratch_.setZero(grid.transverse + kMaxLanes);
 }
 
 void NonlinearString::applyStiffness(const Vector& q, Vector& out) const {
@@ -202,8 +202,8 @@ void NonlinearString::cellStrains(const Vector& q, double* strain, double* sumIn
   const Eigen::Index m = segments_, mv = grid_.longitudinal;
   padded(q.data(), m, work3_.data());
   longitudinalStrains(q.data() + (m - 1), mv, 1.0 / hv_, cell1_.data());
-  kernels_->cellStretches(work3_.data(), cell1_.data(), mv, ratio_, 1.0 / h_, scratch_.data(),
-                          zetaOverS, strain, sumInverse);
+  kernels_->cellStretches(work3_.data(), cell1_.data(), mv, ratio_, 1.0 / h_, zetaOverS, strain,
+                          sumInverse);
 }
 
 // SCHEMES §3b: ε_J = (1/r) Σ_{l∈J} (s_l − 1), V' = (EA − T0)/2 Σ_J h_v ε_J².

@@ -11,27 +11,35 @@ namespace {
 constexpr int kLanes = HAMILTONE_KERNEL_LANES;
 static_assert(kLanes <= kMaxLanes);
 
-// Cell by cell, in chunks of kChunk segments: a cell's last chunk runs past its r segments into
-// the following cells' (or the padding's), and they write those values again. The loop of one
-// chunk has a fixed trip count, so it is one vector iteration; a loop of r = 8…17 would not
-// vectorise, nor would one over the whole grid without spreading each η_J over its r segments
-// first. Four lanes at most, also on AVX-512: a chunk of eight would compute up to 78 % more
-// square roots and divisions than r (r = 9: 16), and those are what the kernel waits on. Cell J's
-// sums come after cell J + 1's chunks, whose square roots and divisions then run while the sums'
-// chain of additions waits on J's.
-constexpr int kChunk = kLanes < 4 ? kLanes : 4;
+// Cell by cell, in chunks of four segments on every path (one vector iteration on AVX2 and
+// AVX-512, two on SSE2): a cell's last chunk runs past its r segments into the following cells'
+// (or the padding's), and they write those values again. The loop of one chunk has a fixed trip
+// count, so it vectorises; a loop of r = 8…17 would not, nor would one over the whole grid
+// without spreading each η_J over its r segments first. Four, not eight on AVX-512: a chunk of
+// eight would compute up to 78 % more square roots and divisions than r (r = 9: 16), and those
+// are what the kernel waits on. A cell's sums are four partial sums, one per position in the
+// chunk (its last chunk adds 0 for the segments past the cell), then added as (p0 + p1) +
+// (p2 + p3): they stay in registers, every path adds the same values in the same order (so
+// every path gives the same bits), and cell J's come after cell J + 1's chunks, whose square
+// roots and divisions then run while J's additions wait.
+constexpr int kChunk = 4;
+
+// Four doubles: one vector register on AVX2 and AVX-512, two on SSE2.
+typedef double Chunk __attribute__((vector_size(kChunk * sizeof(double))));
 
 HAMILTONE_TARGET void cellStretches(const double* up, const double* eta, long mv, int r,
-                                    double invH, double* scratch, double* zetaOverS, double* strain,
+                                    double invH, double* zetaOverS, double* strain,
                                     double* sumInverse) {
-  const long m = mv * r;
-  double* excess = scratch;
-  double* inverse = scratch + m + kMaxLanes;
+  const Chunk position = {0.0, 1.0, 2.0, 3.0}, zero = {};
   const double invR = 1.0 / r;
+  Chunk excessSum = {}, inverseSum = {};  // cell J − 1's Σ (s_l − 1), Σ 1/s_l by position
   for (long j = 0; j <= mv; ++j) {
+    Chunk excessNext = {}, inverseNext = {};  // cell J's
     if (j < mv) {
       const double aj = (1.0 + eta[j]) * (1.0 + eta[j]), bj = 2.0 * eta[j] + eta[j] * eta[j];
-      for (long t = j * r; t < (j + 1) * r; t += kChunk) {
+      const long end = (j + 1) * r;
+      for (long t = j * r; t < end; t += kChunk) {
+        double excess[kChunk], inverse[kChunk];
 #pragma omp simd
         for (int i = 0; i < kChunk; ++i) {
           const long l = t + i;
@@ -39,21 +47,24 @@ HAMILTONE_TARGET void cellStretches(const double* up, const double* eta, long mv
           const double stretch = __builtin_sqrt(aj + z2);
           const double d = 1.0 / (stretch * (stretch + 1.0));  // one division for all three
           const double inv = (stretch + 1.0) * d;
-          excess[l] = (bj + z2) * stretch * d;
-          inverse[l] = inv;
+          excess[i] = (bj + z2) * stretch * d;
+          inverse[i] = inv;
           zetaOverS[l] = zeta * inv;
         }
+        Chunk e, v;
+        __builtin_memcpy(&e, excess, sizeof e);
+        __builtin_memcpy(&v, inverse, sizeof v);
+        const auto inside = position < static_cast<double>(end - t);
+        excessNext += inside ? e : zero;
+        inverseNext += inside ? v : zero;
       }
     }
-    if (j > 0) {  // cell j − 1, its sums in order of l: the same bits on every path
-      double e = 0.0, i = 0.0;
-      for (long l = (j - 1) * r; l < j * r; ++l) {
-        e += excess[l];
-        i += inverse[l];
-      }
-      strain[j - 1] = e * invR;
-      sumInverse[j - 1] = i;
+    if (j > 0) {
+      strain[j - 1] = ((excessSum[0] + excessSum[1]) + (excessSum[2] + excessSum[3])) * invR;
+      sumInverse[j - 1] = (inverseSum[0] + inverseSum[1]) + (inverseSum[2] + inverseSum[3]);
     }
+    excessSum = excessNext;
+    inverseSum = inverseNext;
   }
 }
 

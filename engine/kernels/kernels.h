@@ -19,11 +19,12 @@ struct Kernels {
   // The two grids' strains (SCHEMES §3b): with up the padded u (u_0 = u_m = 0, m = mv r) and
   // η_J the coarse strains, each fine segment's s_l = sqrt((1 + η_J)² + ζ_l²), ζ_l = (up[l+1] −
   // up[l]) invH; sets zetaOverS_l = ζ_l/s_l, strain_J = (1/r) Σ_{l∈J} (s_l − 1) (as (b + ζ²)/(s +
-  // 1), b = 2η + η²: no cancellation at small strain) and sumInverse_J = Σ_{l∈J} 1/s_l.
-  // The loops run in whole chunks of up to four segments past the last one: up holds m + kMaxLanes
-  // values (finite: zeros past u_m), zetaOverS m + kMaxLanes; scratch: 2 (m + kMaxLanes) doubles.
+  // 1), b = 2η + η²: no cancellation at small strain) and sumInverse_J = Σ_{l∈J} 1/s_l, each sum
+  // as four partial sums over l ≡ 0, 1, 2, 3 (mod 4) from the cell's first segment, added as
+  // (p0 + p1) + (p2 + p3) on every path. The loops run in whole chunks of four segments past the
+  // last one: up holds m + kMaxLanes values (finite: zeros past u_m), zetaOverS m + kMaxLanes.
   void (*cellStretches)(const double* up, const double* eta, long mv, int r, double invH,
-                        double* scratch, double* zetaOverS, double* strain, double* sumInverse);
+                        double* zetaOverS, double* strain, double* sumInverse);
   // ∇_u V' = D₋ᵀ(c strain_J ζ_l/s_l): gu_l = (w_l − w_{l+1}) invH, l < m − 1, zetaOverS as
   // cellStretches left it. scratch: m + kMaxLanes doubles.
   void (*fineForces)(long mv, int r, double c, double invH, const double* strain, double* scratch,
