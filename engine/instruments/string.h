@@ -103,7 +103,7 @@ class NonlinearString {
   mutable double endTension_ = 0.0;
   // Work of the stencils and the gradient: per fine segment (size Mu; work3_ holds u padded with
   // its fixed ends, Mu + 1, then zeros; work1_ and scratch_ the two-grid kernels', Mu + kMaxLanes
-  // each) and per coarse cell (Mv).
+  // each, scratch_ also the single grid's padded v) and per coarse cell (Mv).
   mutable Vector work1_, work2_, work3_, cell1_, cell2_, cell3_;
   mutable Vector scratch_;
   const Kernels* kernels_ = &selectedKernels();
