@@ -237,10 +237,9 @@ def run(ctx):
         f"±{BAND / 2:g} Hz of √(E/ρ)/2L, in dB re its peak;\n"
         "- **cost**: the process loop's wall time per audio sample, the least of at least 5 "
         "renders (and of 1 s of renders per key and velocity, the two voices' together), the "
-        "transverse and two-grid "
-        "voices taking turns; the reference rendered once. The least, not the median: the "
-        "machine is shared, its other jobs only ever add to a render's time, and the median "
-        "ratios moved by ±0.1 between two runs of this report.\n")
+        "transverse and two-grid voices taking turns; the reference rendered once. The least, "
+        "not the median: the machine is shared, its other jobs only ever add to a render's time, "
+        "and the median ratios moved by ±0.1 between two runs of this report.\n")
     out.append(code(command))
     if ctx.quick:
         out.append(f"(`--quick`: keys {', '.join(name[m] for m in keys)} only; the full report "
