@@ -56,8 +56,9 @@ namespace {
 // longitudinal wave (c_L k / h_v <= 1) any ε > 0 gives the converged glide, and ε = 0 does not
 // (g is direction-dependent at rest: a first-mode start glides at 0.4 of the converged rate), so
 // the default is a share of the hardest strike's energy. Where it does not (the transverse grid,
-// c_L k / h ≈ 15), ψ drifts from sqrt(2 (V' + ε)) by an amount that grows with ε: the output turns
-// into noise from about the strike's energy on, so ε is kept to a hundredth of it, 0 by default.
+// c_L k / h ≈ 15, and the two grids' single cell on the top keys, shorter than c_L k), ψ drifts
+// from sqrt(2 (V' + ε)) by an amount that grows with ε: the output turns into noise from about the
+// strike's energy on, so ε is kept to a hundredth of it, 0 by default.
 double gaugeShift(const StringPatch& patch, const NonlinearString& string, double k) {
   const StringPhysics& p = string.physics();
   const double courant = std::sqrt(p.young / p.density) * k / string.longitudinalSpacing();
@@ -70,6 +71,22 @@ double gaugeShift(const StringPatch& patch, const NonlinearString& string, doubl
   }
   const double epsilon = patch.epsilon.value_or(0.0);
   const double most = kUnresolvedEpsilonShare * strike;
+  // A string shorter than c_L k (the top keys at 48 kHz) is unresolved on the two grids too: their
+  // one coarse cell is the whole string, and the mean stretch of this Kirchhoff–Carrier limit moves
+  // faster than a step, so ψ drifts as on the transverse grid (measured, C7–C8: ε = 1 J is noise).
+  // Only a shorter step resolves it.
+  const double shortness = std::sqrt(p.young / p.density) * k / p.length;  // c_L k / L
+  std::string remedy = "grid_rule \"two-grid\" accepts any ε";
+  if (shortness > 1.0) {
+    int enough = patch.oversampling;
+    while (enough < 64 && enough < patch.oversampling * shortness) enough *= 2;
+    remedy =
+        "the string is shorter than c_L k, so the two grids' one coarse cell does not "
+        "resolve it either; " +
+        (enough >= patch.oversampling * shortness
+             ? "oversampling " + std::to_string(enough) + " does, and accepts any ε"
+             : std::string("no oversampling up to 64 does"));
+  }
   require(
       epsilon >= 0.0 && epsilon <= most, "epsilon_j", epsilon,
       "between 0 and " + formatApprox(most, 3) +
@@ -77,7 +94,7 @@ double gaugeShift(const StringPatch& patch, const NonlinearString& string, doubl
           " exceeds 1, and a larger gauge shift lets ψ drift from sqrt(2(V'+ε)) until the "
           "output is noise (at most a hundredth of the hardest strike's energy ½ M_H v_max² "
           "= " +
-          formatApprox(strike, 3) + " J; grid_rule \"two-grid\" accepts any ε)");
+          formatApprox(strike, 3) + " J; " + remedy + ")");
   return epsilon;
 }
 

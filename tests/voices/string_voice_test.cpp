@@ -413,6 +413,34 @@ TEST(StringVoice, GaugeShiftDefaultsAndLimitsFollowTheGrid) {
   }
   EXPECT_LE(gap, 1e-3 * peak);
 
+  // C8 is shorter than c_L k: on the two grids it is one coarse cell (Mv = 1, v has no unknowns),
+  // and its mean stretch still moves faster than a step, so ψ drifts as on the transverse grid
+  // (measured: ε = 1 J is noise, ε <= 1.7 mJ within 1.4 % of ε = 0). The refusal names the
+  // oversampling that resolves it, where the default is the resolved one again.
+  StringPatch top = piano(108);
+  voice.prepare(top, 108, 48000.0);
+  ASSERT_EQ(voice.scheme().system().string().grid().longitudinal, 1);
+  EXPECT_EQ(voice.scheme().parameters().epsilon, 0.0);
+  top.epsilon = 1.0;
+  try {
+    voice.prepare(top, 108, 48000.0);
+    FAIL() << "epsilon 1 J accepted on C8's one coarse cell";
+  } catch (const std::invalid_argument& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind("epsilon_j = 1: must be between 0 and 0.0017 J on this grid", 0), 0)
+        << what;
+    EXPECT_NE(what.find("the string is shorter than c_L k, so the two grids' one coarse cell does "
+                        "not resolve it either; oversampling 4 does, and accepts any ε"),
+              std::string::npos)
+        << what;
+  }
+  top.oversampling = 4;
+  top.epsilon.reset();
+  voice.prepare(top, 108, 48000.0);
+  EXPECT_DOUBLE_EQ(voice.scheme().parameters().epsilon, kEpsilonShare * strikeEnergyScale(top));
+  top.epsilon = 1.0;
+  EXPECT_NO_THROW(voice.prepare(top, 108, 48000.0));
+
   patch.grid = GridRule::transverse;
   patch.epsilon.reset();
   voice.prepare(patch, 48, 48000.0);
