@@ -63,27 +63,35 @@ class QuietDetector {
   void strike() noexcept { quietSamples_ = 0, loudest_ = envelope_; }
   // Call after each block with its samples: fades them (and `alongside`, when given: a signal that
   // must fall silent with them, sample for sample) if the voice is going quiet. Returns true when
-  // the voice is now free.
+  // the voice is now free; freedAt() then says from which of these samples it is silent.
   bool update(std::span<float> left, std::span<float> right, size_t rightCount,
               std::span<float> alongside = {}) noexcept {
+    freedAt_ = -1;
     for (size_t i = 0; i < left.size(); ++i) {
-      const double peak = std::max(std::abs(left[i]), i < rightCount ? std::abs(right[i]) : 0.0f);
-      envelope_ = std::max(peak, envelope_ * decay_);
-      loudest_ = std::max(loudest_, envelope_);
-      const bool quiet = envelope_ <= kLevel * loudest_ && envelope_ <= floor_;
-      quietSamples_ = quiet ? quietSamples_ + 1 : 0;
-      if (quietSamples_ == 0) continue;
+      // Free from the sample the hold ends, for good: what the voice would do after it in this
+      // block must not matter, or the moment it is freed would depend on where blocks end.
+      if (freedAt_ < 0) {
+        const double peak = std::max(std::abs(left[i]), i < rightCount ? std::abs(right[i]) : 0.0f);
+        envelope_ = std::max(peak, envelope_ * decay_);
+        loudest_ = std::max(loudest_, envelope_);
+        const bool quiet = envelope_ <= kLevel * loudest_ && envelope_ <= floor_;
+        quietSamples_ = quiet ? quietSamples_ + 1 : 0;
+        if (quietSamples_ == 0) continue;
+        if (quietSamples_ == holdSamples_) freedAt_ = static_cast<long>(i);  // gain 0 from here
+      }
       const float gain = static_cast<float>(
           std::max(0.0, 1.0 - static_cast<double>(quietSamples_) / holdSamples_));
       left[i] *= gain;
       if (i < rightCount) right[i] *= gain;
       if (i < alongside.size()) alongside[i] *= gain;
     }
-    return quietSamples_ >= holdSamples_;
+    return freedAt_ >= 0;
   }
+  // The sample of the last update() at which the hold ended (its output 0 from there on), or −1.
+  long freedAt() const noexcept { return freedAt_; }
 
  private:
-  long quietSamples_ = 0, holdSamples_ = 1;
+  long quietSamples_ = 0, holdSamples_ = 1, freedAt_ = -1;
   double envelope_ = 0.0, loudest_ = 0.0, decay_ = 0.0, floor_ = kFloor;
 };
 

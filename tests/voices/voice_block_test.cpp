@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <vector>
@@ -92,6 +93,47 @@ TEST(QuietDetector, AStrikeMeasuresTheNewNoteFromItsOwnPeak) {
   bool louder = false;
   const double freed = freedAt(quiet, 1e-3, 0.2, 4.0, louder);
   expectFreedAfter(freed, 1e-3, 0.2, QuietDetector::kLevel * 1e-3);
+}
+
+}  // namespace
+}  // namespace hamiltone
+
+namespace hamiltone {
+namespace {
+
+// Quiet for the 50 ms hold, then loud again a moment later (the beat of two unison strings can
+// do it): the voice is free from the sample the hold ends, whether that sample's block ends
+// quiet or loud. Blocks of 100 and one block of the whole signal agree on where, and on every
+// sample. (The check once looked only at a block's end: the single block, ending loud, kept the
+// voice; a G2 then ended 0.5 s apart in blocks of 100 and 256.)
+TEST(QuietDetector, TheVoiceIsFreedWhereTheHoldEndsWhateverTheBlocks) {
+  const long n = 24000;
+  std::vector<float> signal(n, 1e-7f);
+  for (long i = 0; i < 1000; ++i) signal[i] = (i % 2 == 0) ? 0.5f : -0.5f;
+  auto run = [&](long block, long& freed) {
+    QuietDetector quiet;
+    quiet.prepare(kRate);
+    std::vector<float> left = signal, right(n, 0.0f);
+    freed = -1;
+    for (long start = 0; start < n && freed < 0; start += block) {
+      const long count = std::min(block, n - start);
+      if (quiet.update(std::span(left).subspan(start, count),
+                       std::span(right).subspan(start, count), count))
+        freed = start + quiet.freedAt();
+    }
+    return left;
+  };
+  long bySample = 0, inBlocks = 0, whole = 0;
+  run(1, bySample);  // where the hold ends: the follower's 20 ms release from 0.5, then 50 ms
+  ASSERT_GT(bySample, 1000 + std::lround(QuietDetector::kHoldS * kRate));
+  ASSERT_LT(bySample, n - 1000);
+  for (long i = bySample + 200; i < n; ++i) signal[i] = 0.5f;  // loud again after it
+  const std::vector<float> a = run(100, inBlocks), b = run(n, whole);
+  EXPECT_EQ(inBlocks, bySample);
+  EXPECT_EQ(whole, bySample);
+  // The same samples up to the free one (after it the caller calls no more: the voice is reset).
+  for (long i = 0; i <= bySample; ++i) ASSERT_EQ(a[i], b[i]) << i;
+  for (long i = bySample; i < n; ++i) ASSERT_EQ(b[i], 0.0f) << i;
 }
 
 }  // namespace
