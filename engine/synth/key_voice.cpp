@@ -109,11 +109,13 @@ double KeyVoice::fundamentalHz() const {
 
 void KeyVoice::process(size_t frames, double gain) noexcept {
   frames_ = frames;
+  freedAt_ = -1;
   const std::span<float> left(outLeft_.data(), frames), right(outRight_.data(), frames);
   size_t done = 0;
   while (done < frames) {
     if (!fading() && pending()) {  // the fade is over (or its voices fell silent): strike
       strikeNow(pendingVelocity_, pendingUnaCorda_);
+      freedAt_ = -1;
       pendingVelocity_ = -1.0;
       if (releasePending_) release(damperScale_, contact_);
       releasePending_ = false;
@@ -124,6 +126,7 @@ void KeyVoice::process(size_t frames, double gain) noexcept {
     render(done, length, gain);
     done += length;
     if (wasFading && !fading()) {  // free the voices; a pending strike starts next round
+      if (freedAt_ < 0 && sounding()) freedAt_ = static_cast<long>(done);
       std::visit([](auto& v) { v.reset(); }, voice_);
       if (!pending()) break;
     }
@@ -143,6 +146,8 @@ void KeyVoice::render(size_t offset, size_t n, double gain) noexcept {
   if (UnisonStrings* strings = std::get_if<UnisonStrings>(&voice_)) {
     strings->process(mixL, mixR);  // silence when no string sounds
     bridge = strings->boardForce().data();
+    if (strings->freedAt() >= 0 && freedAt_ < 0)
+      freedAt_ = static_cast<long>(offset) + strings->freedAt();
   } else if (PlateVoice& plate = std::get<PlateVoice>(voice_); plate.active()) {
     plate.process(mixL, mixR);
   } else {

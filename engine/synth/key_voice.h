@@ -48,6 +48,10 @@ class KeyVoice {
   // What the key's bridge passed to the soundboard over the last process(), N per sample (faded
   // with the output); zeros for a key without a bridge.
   std::span<const float> boardForce() const { return {boardForce_.data(), frames_}; }
+  // The sample of the last process() from which the key's bridged strings are silent and drive
+  // the board no more (they fell quiet, their fade ended, or the guard silenced them) with no
+  // strike after it in that piece; −1 otherwise. The same sample whatever the block size.
+  long freedAt() const { return freedAt_; }
 
   bool sounding() const;  // a voice of the key is active
   bool fading() const { return fadeLeft_ > 0; }
@@ -80,6 +84,7 @@ class KeyVoice {
   std::variant<UnisonStrings, PlateVoice> voice_;  // one voice type per instrument model
   std::vector<float> mixLeft_, mixRight_, outLeft_, outRight_, boardForce_;
   size_t frames_ = 0;  // written to the outputs by the last process()
+  long freedAt_ = -1;
   double panLeft_ = 1.0, panRight_ = 1.0;
   int fadeSamples_ = 1, fadeLeft_ = 0;
   double pendingVelocity_ = -1.0;  // < 0: none

@@ -66,6 +66,7 @@ void Synth::prepare(std::vector<Instrument> instruments, const SynthSetup& setup
     const size_t count = instrument.keys.size();
     body->forces.assign(count, 0.0);
     body->driving.assign(count, nullptr);
+    body->rejoinAt.assign(count, -1);
     body->drivers.assign(count, 0);
     body->struck.assign(count, 0);
     body->excludedAt.assign(count, kNever);
@@ -382,7 +383,14 @@ void Synth::renderBody(size_t program, std::span<float> left, std::span<float> r
       b.excludedAt[key] = b.clock;
       b.body.setExcluded(key, true);
     }
+    // Fallen silent in this piece, and not struck again: from that sample its strings are the
+    // body's again, at rest on the board, to ring in sympathy with the keys played after it.
+    b.rejoinAt[d] = v.busy() ? -1 : v.freedAt();
   }
+  auto rejoin = [&](long sample) {
+    for (int d = 0; d < drivers; ++d)
+      if (b.rejoinAt[d] == sample) b.body.setExcluded(b.drivers[d], false);
+  };
   for (size_t key = 0; key < b.forces.size(); ++key) {
     const KeyVoice& v = voices_[program][key];
     const int k = static_cast<int>(key);
@@ -392,12 +400,13 @@ void Synth::renderBody(size_t program, std::span<float> left, std::span<float> r
       b.contact[key] = contact;
     }
   }
-  if (b.resting && drivers == 0) {
+  if (b.resting && drivers == 0) {  // none to rejoin: a driver is a key busy at the start
     b.clock += static_cast<long>(left.size());
     b.fadeLeft = static_cast<int>(std::max(0L, b.fadeLeft - static_cast<long>(left.size())));
     return;
   }
   for (size_t i = 0; i < left.size(); ++i) {
+    rejoin(static_cast<long>(i));
     bool pushed = false;
     for (int d = 0; d < drivers; ++d) {
       const double f = b.driving[d][i];
@@ -428,6 +437,7 @@ void Synth::renderBody(size_t program, std::span<float> left, std::span<float> r
                      b.clock - b.lastLoud >= kBodyRestCheck))
       rest(b);
   }
+  rejoin(static_cast<long>(left.size()));  // fallen silent with the piece's last sample
 }
 
 // At rest, exactly; every key's strings back on the board — but those of a key struck in the

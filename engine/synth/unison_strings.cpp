@@ -127,6 +127,7 @@ void UnisonStrings::processBridged(std::span<float> left, std::span<float> right
     std::fill(right.begin(), right.end(), 0.0f);
     std::fill(boardForce_.begin(), boardForce_.begin() + n, 0.0f);
   };
+  freedAt_ = -1;
   if (!active_) {
     silence();
     return;
@@ -162,11 +163,15 @@ void UnisonStrings::processBridged(std::span<float> left, std::span<float> right
   if (!finite || !std::isfinite(h) || h > multiple * injectedEnergy()) {
     silence();
     ++guardEvents_;
+    freedAt_ = 0;  // silenced from the first sample
     reset();
     return;
   }
   // The board's force falls silent with the sound, at the same sample whatever the block size.
-  if (quiet_.update(left, right, n, std::span(boardForce_).first(n))) active_ = false;
+  if (quiet_.update(left, right, n, std::span(boardForce_).first(n))) {
+    active_ = false;
+    freedAt_ = quiet_.freedAt();
+  }
 }
 
 }  // namespace hamiltone

@@ -39,6 +39,9 @@ class UnisonStrings {
   std::span<const float> boardForce() const { return {boardForce_.data(), frames_}; }
 
   bool active() const;  // a string sounds
+  // The bridged key fell silent for good in the last process(): from this sample on its output and
+  // board force are 0, whatever the block size. −1 if it did not.
+  long freedAt() const { return freedAt_; }
   int guardEvents() const;
   double fundamentalHz() const { return strings_.front().fundamentalHz(); }  // the first string's
   size_t size() const { return strings_.size(); }
@@ -58,6 +61,7 @@ class UnisonStrings {
   double sinAngle_ = 0.0;  // sin α of the bridge: the share of the tension change that pushes it
   bool bridged_ = false, active_ = false;  // active_: the bridged key's, as one voice
   int guardEvents_ = 0;
+  long freedAt_ = -1;
   QuietDetector quiet_;  // the bridged key's, on its summed output
   std::vector<float> boardForce_, scratchLeft_, scratchRight_;
   size_t frames_ = 0;

@@ -94,6 +94,60 @@ TEST(SynthBody, ThePedalLetsTheOtherStringsRingInSympathy) {
   EXPECT_GT(atPartials, 0.5 * power);
 }
 
+// A key played and released earlier rings in sympathy again once its voice has fallen silent:
+// its strings go back to the board from the sample its voice ends (KeyVoice::freedAt), not at the
+// body's next rest, which a piece with a key always down never reaches (C6 held here). G2 … G3,
+// staccato with the pedal up, then only C6 until every one of their voices has ended; at 5 s the
+// pedal goes down and C4 is struck: the piano then sounds as one where the warm-up never was, but
+// for what the board and the damped strings kept of it. Measured: −108 dB apart (before, the
+// warm-up's strings stayed out of the coupling: −2 dB apart). And the same bits whatever the block
+// size, though the voices end inside blocks (the quiet check once freed a voice at a block's end
+// only if it was still quiet there: G2 alone ended 0.5 s apart in blocks of 100 and 256).
+TEST(SynthBody, KeysPlayedEarlierRingInSympathyOnceTheirVoicesEnd) {
+  // Measured: their voices end 0.8 (G3) to 4.1 s (E3: a partial the felt barely damps) after
+  // the start.
+  const double pedal = 5.0, end = 7.0;
+  const int warm[] = {43, 48, 52, 55};  // G2, C3, E3, G3: C4's partials among theirs
+  auto take = [&](bool warmUp, int block) {
+    Synth synth;
+    std::vector<bool> notes(128, false);
+    for (int key : warm) notes[key] = true;
+    notes[60] = notes[84] = true;
+    synth.prepare({loadPreset(HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml")},
+                  {.sampleRate = kTakeRate, .maxBlock = 256, .notes = notes, .threads = 1});
+    std::vector<TimedMessage> messages{{0.0, on(84, 60)}};
+    for (size_t i = 0; warmUp && i < std::size(warm); ++i) {
+      messages.push_back({0.02 * static_cast<double>(i), on(warm[i], 90)});
+      messages.push_back({0.02 * static_cast<double>(i) + 0.05, off(warm[i])});
+    }
+    messages.push_back({pedal, cc(64, 127)});
+    messages.push_back({pedal + 0.01, on(60, 100)});
+    std::stable_sort(messages.begin(), messages.end(),
+                     [](const auto& a, const auto& b) { return a.seconds < b.seconds; });
+    int sounding = -1;
+    testing::Take t = testing::render(synth, messages, end, block, [&](long frames) {
+      if (frames <= std::lround(pedal * kTakeRate)) sounding = synth.activeVoices();
+    });
+    EXPECT_EQ(sounding, 1) << "a warm-up voice still sounds when the pedal goes down";
+    return t;
+  };
+  const testing::Take warmed = take(true, 256), fresh = take(false, 256);
+  double power = 0.0, apart = 0.0;
+  for (long i = std::lround((pedal + 0.5) * kTakeRate); i < std::lround(end * kTakeRate); ++i) {
+    power += static_cast<double>(fresh.left[i]) * fresh.left[i];
+    const double d = static_cast<double>(warmed.left[i]) - fresh.left[i];
+    apart += d * d;
+  }
+  const double db = 10.0 * std::log10(apart / power);
+  std::printf("pedalled C4 after a warm-up against without: %.1f dB apart\n", db);
+  EXPECT_LT(db, -60.0);
+  const testing::Take other = take(true, 100);
+  size_t first = 0;
+  while (first < other.left.size() && other.left[first] == warmed.left[first]) ++first;
+  EXPECT_EQ(first, other.left.size()) << "blocks of 100 and 256 part at sample " << first;
+  EXPECT_EQ(other.right, warmed.right);
+}
+
 // A staccato C4 with the pedal up: its voice dies under its damper (T60 0.51 s) and the body,
 // undriven, rests once under the voices' quiet floor. What rings longest is the treble from F6 up,
 // which has no damper and answers C4's upper partials: −92 dBFS at the release, decaying at the
