@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
+#include <set>
 #include <system_error>
 #include <utility>
 
@@ -18,6 +19,7 @@ constexpr std::size_t chunkHeaderBytes = 8;     // 4-byte type, 4-byte big-endia
 struct TickedMessage {
   std::uint64_t tick;
   MidiMessage message;
+  int track;
 };
 struct TempoChange {
   std::uint64_t tick;
@@ -148,7 +150,52 @@ void countEvent(const Cursor& track, std::size_t at, const TrackEvents& events) 
 }
 
 // The events of one track chunk, appended to `events`.
-void readTrack(Cursor track, TrackEvents& events) {
+// At one tick, tracks in order, each in its file order — except that a note-on waits while another
+// track's next event at that tick is a note-off: a key one track releases and another strikes at
+// the same tick then sounds, as a sequencer plays it (track order had the strike damped at once).
+// Nothing else moves, and each track keeps its own order: a note a track starts and ends at one
+// tick stays a strike and a release. `m` is sorted by tick, then track, then file order.
+void noteOffsBeforeOtherTracksNoteOns(std::vector<TickedMessage>& m) {
+  auto isNoteOff = [](const MidiMessage& x) {
+    return x.kind() == midi::noteOff || (x.kind() == midi::noteOn && x.data2 == 0);
+  };
+  std::vector<TickedMessage> merged;
+  std::vector<std::size_t> next, end;  // per track of the tick: its events still to place
+  std::set<std::size_t> heads,
+      offHeads;  // tracks (by rank) with events left, and with a note-off next
+  for (std::size_t begin = 0; begin < m.size();) {
+    std::size_t stop = begin + 1;
+    while (stop < m.size() && m[stop].tick == m[begin].tick) ++stop;
+    if (m[begin].track == m[stop - 1].track) {  // one track at this tick: its order stands
+      begin = stop;
+      continue;
+    }
+    next.clear(), end.clear(), heads.clear(), offHeads.clear();
+    for (std::size_t i = begin; i < stop; ++i) {
+      if (i == begin || m[i].track != m[i - 1].track) next.push_back(i), end.push_back(i);
+      ++end.back();
+    }
+    auto enter = [&](std::size_t t) {
+      if (next[t] == end[t]) return;
+      heads.insert(t);
+      if (isNoteOff(m[next[t]].message)) offHeads.insert(t);
+    };
+    for (std::size_t t = 0; t < next.size(); ++t) enter(t);
+    merged.clear();
+    while (!heads.empty()) {
+      std::size_t t = *heads.begin();
+      const MidiMessage& head = m[next[t]].message;
+      if (head.kind() == midi::noteOn && head.data2 > 0 && !offHeads.empty()) t = *offHeads.begin();
+      heads.erase(t), offHeads.erase(t);
+      merged.push_back(m[next[t]++]);
+      enter(t);
+    }
+    std::copy(merged.begin(), merged.end(), m.begin() + static_cast<std::ptrdiff_t>(begin));
+    begin = stop;
+  }
+}
+
+void readTrack(Cursor track, int index, TrackEvents& events) {
   // A delta is < 2^28 and takes ≥ 2 bytes with its event, so in a file of ≤ 64 MiB the tick stays
   // below 2^53: no overflow, and exact as a double.
   std::uint64_t tick = 0;
@@ -174,7 +221,7 @@ void readTrack(Cursor track, TrackEvents& events) {
       const int kind = m.kind();
       if (kind != midi::program && kind != midi::channelPressure) m.data2 = dataByte(track, status);
       countEvent(track, at, events);
-      events.messages.push_back({tick, m});
+      events.messages.push_back({tick, m, index});
     } else if (status == 0xF0 || status == 0xF7) {
       // A sysex message, or an escape (F7): its length, then data we skip unread.
       track.skip(track.variable("a sysex length"), "sysex data");
@@ -310,13 +357,15 @@ MidiFile parseMidiFile(std::span<const std::uint8_t> bytes, const std::string& n
                                    std::to_string(midi.tracks) + " tracks the header declares");
     const Chunk chunk = readChunk(file, bytes);
     if (!isType(chunk, "MTrk")) continue;  // a chunk type we do not know: skipped
-    readTrack(Cursor(bytes, chunk.begin, chunk.end, name, "the track chunk"), events);
+    readTrack(Cursor(bytes, chunk.begin, chunk.end, name, "the track chunk"), found, events);
     ++found;
   }
 
-  // Merge the tracks: a stable sort keeps track order, then file order, at equal ticks.
+  // Merge the tracks: a stable sort keeps track order, then file order, at equal ticks; then
+  // another track's note-off goes before a note-on there.
   std::stable_sort(events.messages.begin(), events.messages.end(),
                    [](const TickedMessage& a, const TickedMessage& b) { return a.tick < b.tick; });
+  noteOffsBeforeOtherTracksNoteOns(events.messages);
   TempoMap map(timing, std::move(events.tempos));
   midi.messages.reserve(events.messages.size());
   for (const TickedMessage& m : events.messages)

@@ -33,7 +33,9 @@ struct MidiFile {
   int tracks = 0;    // track chunks read: as many as the header declares
   int division = 0;  // ticks per quarter note; with SMPTE timing, the header's raw word (≥ 0x8000)
   // Channel voice messages (status 0x80–0xEF) only, in time order; messages at the same time keep
-  // track order, then their order in the track. Note-on with velocity 0 is kept as it is.
+  // track order, then their order in the track, but for a note-on that another track's note-off
+  // at that time would follow: the note-off goes first (a key released in one track and struck
+  // in another sounds). Note-on with velocity 0 is kept as it is (and is a note-off).
   std::vector<TimedMessage> messages;
   double lengthSeconds = 0.0;  // time of the last event of any kind, End of Track included
 };

@@ -113,6 +113,30 @@ TEST(MidiFile, Format1MergesTracksThroughTheTempoMapOfTrack0) {
   EXPECT_NEAR(midi.lengthSeconds, 3.0, timeTolerance);
 }
 
+// At one tick a note-on waits for another track's note-off due then: C4 released by the second
+// track and struck by the first at 1 s sounds (in track order it was damped at once). Each track
+// keeps its own order — the first track's D4 started and ended at that tick stays on, off — and
+// nothing but a note-on moves: the pedal (CC64) in the first track stays before the off.
+TEST(MidiFile, AtOneTickAnotherTracksNoteOffGoesBeforeANoteOn) {
+  TrackWriter first, second;
+  first.event(480, {0xB0, 64, 127})
+      .event(0, {0x90, 60, 90})
+      .event(0, {0x90, 62, 80})
+      .event(0, {0x80, 62, 0})
+      .event(480, {0x80, 60, 0})
+      .endOfTrack();
+  second.event(0, {0x90, 60, 70}).event(480, {0x90, 60, 0}).event(0, {0x90, 62, 50}).endOfTrack();
+  const MidiFile midi = parse(midiFile(1, 480, {first, second}));
+  expectMessages(midi, {{0.0, 0x90, 60, 70},
+                        {0.5, 0xB0, 64, 127},
+                        {0.5, 0x90, 60, 0},
+                        {0.5, 0x90, 60, 90},
+                        {0.5, 0x90, 62, 80},
+                        {0.5, 0x80, 62, 0},
+                        {0.5, 0x90, 62, 50},
+                        {1.0, 0x80, 60, 0}});
+}
+
 // Tempo changes in any track apply to all; at the same tick the later track's stands.
 TEST(MidiFile, TempoChangesInAnyTrackApplyToAll) {
   TrackWriter conductor, notes, late;
