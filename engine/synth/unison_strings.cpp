@@ -45,6 +45,7 @@ void UnisonStrings::noteOn(double velocity, bool unaCorda) noexcept {
   const size_t missed = unaCorda && strings_.size() == 3 ? 1 : 0;
   if (bridged_ && !active_) reset();  // a freed key starts from rest, its bridge too
   for (size_t s = missed; s < strings_.size(); ++s) strings_[s].noteOn(velocity);
+  for (size_t s = 0; s < missed; ++s) strings_[s].liftDamper();  // the key lifts all its dampers
   if (!bridged_) return;
   for (StringVoice& s : strings_) s.wake();
   quiet_.strike();

@@ -299,12 +299,16 @@ void StringVoice::noteOn(double velocity) noexcept {
   scheme_->setCoordinate(w, start, start + speed * k_);
   scheme_->resetPsi(1);
   injected_ += energy() - before;
-  scheme_->setSigma0(loss_.sigma0);  // the damper lifts
-  for (int m = 0; m < feltNodes_; ++m) scheme_->setPointDamper(m, feltNode_[m], 0.0);
+  liftDamper();
   separatedSteps_ = 0;
   struck_ = parked_ = false;
   quiet_.strike();
   active_ = true;
+}
+
+void StringVoice::liftDamper() noexcept {
+  scheme_->setSigma0(loss_.sigma0);
+  for (int m = 0; m < feltNodes_; ++m) scheme_->setPointDamper(m, feltNode_[m], 0.0);
 }
 
 void StringVoice::wake() noexcept {

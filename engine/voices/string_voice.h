@@ -76,6 +76,8 @@ class StringVoice {
   void reset() noexcept;  // the string at rest, the hammer parked, the damper up
 
   void noteOn(double velocity) noexcept;  // velocity 0 … 1
+  // The key is down: the damper leaves the string, struck or not (una corda's missed string).
+  void liftDamper() noexcept;
   // The damper falls, the fundamental's T60 damper_t60_s times `damperScale` added: uniform, every
   // partial alike (releasedSigma0); felt, its felt presses on the string along its width (dashpots
   // on the nodes under it, SavScheme::setPointDamper), each mode damped by its shape there — a

@@ -114,6 +114,30 @@ TEST(UnisonStrings, UnaCordaMissedStringRingsThroughTheBridge) {
   }
 }
 
+// Struck again with una corda while still ringing from a released strike: the key lifts every
+// damper of its strings, the missed one's too, so that string rings on at its own decay instead
+// of dying under the damper it had (it did: −72 dB against −58 for its neighbours, hostile test).
+// Rigid ends, so only its own damper acts on it. Measured: its energy −0.9 dB over the 0.5 s
+// after the restrike with the damper lifted, −13.7 dB when it stayed down.
+TEST(UnisonStrings, UnaCordaLiftsTheMissedStringsDamperToo) {
+  Instrument piano = grandPiano();
+  piano.keys[60 - piano.lowestNote].bridge = {};
+  UnisonStrings key;
+  key.prepare(piano, 60, kRate, kBlock);
+  key.noteOn(1.0);
+  play(key, 0.2);
+  key.release(1.0, 1.0);
+  play(key, 0.05);
+  key.noteOn(1.0, /*unaCorda=*/true);
+  play(key, 0.05);
+  const double before = key.strings()[0].energy();
+  play(key, 0.5);
+  const double after = key.strings()[0].energy();
+  const double db = 10.0 * std::log10(after / before);
+  std::printf("the missed string over 0.5 s after the restrike: %.1f dB\n", db);
+  EXPECT_GT(db, -5.0);
+}
+
 // The grand piano's strings meet the bridge at 1° (bridge.angle_deg), so a strike's tension pulse
 // reaches the board ahead of the transverse wave and pushes it down, towards the board: the force
 // the key passes to the board is negative (w positive away from it) well before the transverse
