@@ -91,9 +91,12 @@ double NonlinearString::longitudinalEigenvalue(int m) const {
 }
 
 void NonlinearString::setTensionRange(double maxScale) {
-  if (!(maxScale >= 1.0 && maxScale <= 4.0))
+  // An octave up is 4× the tension on an ideal string; 4 + 3B on a stiff one (the fundamental's
+  // stiffness term does not scale), so the largest bend (12 semitones) needs a little over 4.
+  if (!(maxScale >= 1.0 && maxScale <= 5.0))
     throw std::invalid_argument("tension scale range " + formatNumber(maxScale) +
-                                ": must be between 1 and 4 (two octaves of bend)");
+                                ": must be between 1 and 5 (an octave of bend up, stiffness "
+                                "included)");
   tensionScaleMax_ = maxScale;
   tensionScale_ = 1.0;
 }
