@@ -94,6 +94,8 @@ std::string limiterSummary(long limitedFrames, long overFrames, double deepestRe
   char text[200];
   const double peakDb = peakIn > 0.0 ? 20.0 * std::log10(peakIn) : -INFINITY;
   const double ceilingDb = 20.0 * std::log10(ceiling);
+  if (limitedFrames == 0 && !(peakIn > 0.0))
+    return "the output is silent: every sample is 0 (the limiter did not act)";
   if (limitedFrames == 0) {
     std::snprintf(text, sizeof text,
                   "peak %.1f dBFS before the limiter, %.1f dB under its ceiling of %.2f dBFS: it "

@@ -56,7 +56,8 @@ TEST(RenderSummary, StealsWithTheLoudestInDecibels) {
             "12 keys stolen at the limit of 16 voices, the loudest at -6.0 dB of its own peak");
 }
 
-// The limiter's line: the headroom when it did not act, what it did when it did.
+// The limiter's line: the headroom when it did not act, what it did when it did, and a silent
+// output said as such (it read "peak -inf dBFS …, inf dB under its ceiling").
 TEST(RenderSummary, LimiterHeadroomOrWhatItDid) {
   EXPECT_EQ(limiterSummary(0, 0, 0.0, 0.5, 0.98, 48000.0),
             "peak -6.0 dBFS before the limiter, 5.8 dB under its ceiling of -0.18 dBFS: it did "
@@ -64,6 +65,8 @@ TEST(RenderSummary, LimiterHeadroomOrWhatItDid) {
   EXPECT_EQ(limiterSummary(4800, 12, 3.1, 1.4, 0.98, 48000.0),
             "the limiter reduced the gain by up to 3.1 dB on 4800 frames (0.100 s; 12 over its "
             "ceiling of -0.18 dBFS); peak before it +2.9 dBFS");
+  EXPECT_EQ(limiterSummary(0, 0, 0.0, 0.0, 0.98, 48000.0),
+            "the output is silent: every sample is 0 (the limiter did not act)");
 }
 
 TEST(ProgressBar, DisabledWritesNothing) {
