@@ -93,7 +93,8 @@ void warnSilentScore(const Score& score, const std::vector<Instrument>& instrume
     std::fprintf(stderr, "hamiltone-play: warning: %s has no note to play\n", score.what.c_str());
   else if (!outside.empty())
     std::fprintf(stderr,
-                 "hamiltone-play: warning: no preset plays MIDI note(s)%s; they are silent\n",
+                 "hamiltone-play: warning: the preset in force does not play MIDI note(s)%s; "
+                 "they are silent\n",
                  outside.c_str());
 }
 

@@ -58,15 +58,21 @@ std::vector<Instrument> loadPresets(const std::vector<std::string>& files,
 
 std::string unplayedNotes(std::span<const TimedMessage> messages,
                           const std::vector<Instrument>& instruments) {
-  std::vector<bool> notes(128, false);
-  for (const TimedMessage& m : messages)
-    if (m.message.kind() == midi::noteOn) notes[m.message.data1 & 0x7F] = true;
+  // As Synth::handle does: a program change selects one of the loaded presets (others are
+  // ignored), and a note-on of velocity > 0 strikes the key in the preset then in force.
+  std::vector<bool> silent(128, false);
+  size_t program = 0;
+  for (const TimedMessage& m : messages) {
+    if (m.message.kind() == midi::program && m.message.data1 < instruments.size())
+      program = m.message.data1;
+    if (m.message.kind() != midi::noteOn || m.message.data2 == 0 || instruments.empty()) continue;
+    const int note = m.message.data1 & 0x7F;
+    const Instrument& i = instruments[program];
+    if (note < i.lowestNote || note > i.highestNote) silent[note] = true;
+  }
   std::string outside;
   for (int note = 0; note < 128; ++note) {
-    bool playable = false;
-    for (const Instrument& i : instruments)
-      playable = playable || (note >= i.lowestNote && note <= i.highestNote);
-    if (!notes[note] || playable) continue;
+    if (!silent[note]) continue;
     outside += ' ';
     outside += std::to_string(note);
   }

@@ -24,8 +24,9 @@ std::vector<PresetOverride> parseSets(const std::vector<std::string>& sets);
 std::vector<Instrument> loadPresets(const std::vector<std::string>& files,
                                     const std::vector<std::string>& sets);
 
-// The MIDI notes that `messages` turn on but that no instrument plays, as " 5 120" (empty when
-// every one is played): the players warn of them, as they are silent.
+// The MIDI notes that `messages` strike while the preset in force (program changes followed as
+// the synthesizer does) does not play them, as " 5 120" (empty when every one is played): the
+// players warn of them, as they are silent.
 std::string unplayedNotes(std::span<const TimedMessage> messages,
                           const std::vector<Instrument>& instruments);
 

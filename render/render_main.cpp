@@ -104,8 +104,8 @@ int run(const RenderArguments& a) {
   const std::string outside = unplayedNotes(messages, instruments);
   if (!outside.empty() && !a.quiet)
     std::fprintf(stderr,
-                 "hamiltone-render: warning: no preset plays MIDI note(s)%s; they are "
-                 "silent\n",
+                 "hamiltone-render: warning: the preset in force does not play MIDI note(s)%s; "
+                 "they are silent\n",
                  outside.c_str());
 
   Synth synth;

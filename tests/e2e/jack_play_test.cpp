@@ -594,7 +594,7 @@ TEST_F(JackPlay, WarnsOfAScoreThatSoundsNothing) {
   for (const auto& [score, mention] :
        {std::pair<std::vector<std::string>, std::string>{
             {"--notes", "5:100:0.1, A4:80:0.1, 120:100:0.1"},
-            "warning: no preset plays MIDI note(s) 5 120; they are silent"},
+            "warning: the preset in force does not play MIDI note(s) 5 120; they are silent"},
         {{"--midi", midi.string()}, "warning: --midi " + midi.string() + " has no note to play"}}) {
     std::vector<std::string> args = {"--quiet", "--preset", piano};
     args.insert(args.end(), score.begin(), score.end());

@@ -71,3 +71,29 @@ TEST(PresetArguments, EveryPresetsRefusalIsGathered) {
 }
 
 }  // namespace
+
+namespace {
+
+// The notes the players warn are silent: those struck while the preset in force does not play
+// them, program changes followed as the synthesizer follows them — C5 after a change to a gong of
+// C2 … C4 is silent though the piano loaded first plays it (the warning said nothing: a silent
+// file, exit 0); a change to a program beyond those loaded is ignored, and a note-on of velocity 0
+// is a note-off.
+TEST(PresetArguments, UnplayedNotesFollowTheProgramInForce) {
+  using hamiltone::TimedMessage;
+  using hamiltone::cli::unplayedNotes;
+  std::vector<Instrument> two(2);
+  two[0].lowestNote = 21, two[0].highestNote = 108;
+  two[1].lowestNote = 36, two[1].highestNote = 60;
+  const std::vector<TimedMessage> played = {{0.0, {0x90, 72, 90}},  // the piano: played
+                                            {0.1, {0xC0, 1, 0}},
+                                            {0.2, {0x90, 48, 90}},   // the gong: played
+                                            {0.3, {0x90, 72, 90}},   // the gong: silent
+                                            {0.4, {0x90, 100, 0}},   // a note-off
+                                            {0.5, {0xC0, 7, 0}},     // no program 7: ignored
+                                            {0.6, {0x91, 30, 90}}};  // still the gong: silent
+  EXPECT_EQ(unplayedNotes(played, two), " 30 72");
+  EXPECT_EQ(unplayedNotes(std::vector<TimedMessage>{{0.0, {0x90, 72, 90}}}, two), "");
+}
+
+}  // namespace
