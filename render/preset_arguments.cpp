@@ -40,8 +40,9 @@ std::vector<PresetOverride> parseSets(const std::vector<std::string>& sets) {
 }
 
 std::vector<Instrument> loadPresets(const std::vector<std::string>& files,
-                                    const std::vector<std::string>& sets) {
+                                    const std::vector<std::string>& sets, double checkRate) {
   PresetOptions options;
+  options.checkRate = checkRate;
   options.overrides = parseSets(sets);
   std::vector<Instrument> instruments;
   std::string errors;

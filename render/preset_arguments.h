@@ -19,10 +19,12 @@ void addSetOption(CLI::App* app, std::vector<std::string>& sets);
 std::vector<PresetOverride> parseSets(const std::vector<std::string>& sets);
 
 // Every file (or preset name, resolvePreset) loaded with every --set over it
-// (PresetOptions::overrides); UsageError "bad preset:" with every error line of every file, or of
-// a malformed --set, or for the first name that names no preset.
+// (PresetOptions::overrides), its voices checked at `checkRate` (the rate they will play at, when
+// known); UsageError "bad preset:" with every error line of every file, or of a malformed --set,
+// or for the first name that names no preset.
 std::vector<Instrument> loadPresets(const std::vector<std::string>& files,
-                                    const std::vector<std::string>& sets);
+                                    const std::vector<std::string>& sets,
+                                    double checkRate = kCheckRate);
 
 // The MIDI notes that `messages` strike while the preset in force (program changes followed as
 // the synthesizer does) does not play them, as " 5 120" (empty when every one is played): the

@@ -74,7 +74,7 @@ int run(const RenderArguments& a) {
           : static_cast<int>(parseInteger("--threads", a.threads, 1, Synth::kMaxThreads));
 
   // Everything is read and checked before the output file is created.
-  std::vector<Instrument> instruments = loadPresets(presets, a.sets);
+  std::vector<Instrument> instruments = loadPresets(presets, a.sets, rate);
   std::vector<TimedMessage> messages;
   double end = 0.0;
   if (!a.midi.empty()) {

@@ -78,14 +78,15 @@ void buildPlatePatch(const PresetValues& values, Instrument& instrument) {
 }
 
 void checkPlateVoices(const Instrument& instrument,
-                      const std::function<void(std::string_view message, int note)>& refused) {
+                      const std::function<void(std::string_view message, int note)>& refused,
+                      double rate) {
   const int lo = instrument.lowestNote, hi = instrument.highestNote;
   std::set<int> notes{lo, hi};
   const int reference = instrument.plate.referenceNote;
   if (reference >= lo && reference <= hi) notes.insert(reference);
   for (int note : notes) try {
       PlateVoice voice;
-      voice.prepare(instrument.plate, note, kCheckRate);
+      voice.prepare(instrument.plate, note, rate);
     } catch (const std::exception& e) {
       refused(e.what(), note);
     }

@@ -14,10 +14,11 @@ namespace hamiltone {
 // Fills the plate model's part of `instrument`: its PlatePatch.
 void buildPlatePatch(const PresetValues& values, Instrument& instrument);
 
-// Prepares, at kCheckRate, the plate at the lowest, reference (when in range) and highest note;
-// each refusal goes to `refused` with its note.
+// Prepares, at `rate`, the plate at the lowest, reference (when in range) and highest note; each
+// refusal goes to `refused` with its note.
 void checkPlateVoices(const Instrument& instrument,
-                      const std::function<void(std::string_view message, int note)>& refused);
+                      const std::function<void(std::string_view message, int note)>& refused,
+                      double rate);
 
 // The preset parameter behind each field a PlateVoice's complaint names.
 std::span<const VoiceField> plateVoiceFields();

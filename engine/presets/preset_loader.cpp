@@ -308,7 +308,7 @@ class Loader {
   void checkBounds();
   void checkBound(const Parameter& p, const Parameter& other, bool upper);
   Instrument build() const;
-  void checkVoices(const Instrument& instrument);
+  void checkVoices(const Instrument& instrument, double rate);
   void voiceError(std::string_view message, int note);
   std::string withOverrides(Place blamed) const;
 
@@ -376,7 +376,7 @@ Instrument Loader::load(std::string_view text, const PresetOptions& options) {
   checkBounds();
   throwIfErrors();
   Instrument instrument = build();
-  if (options.checkVoices) checkVoices(instrument);
+  if (options.checkVoices) checkVoices(instrument, options.checkRate);
   throwIfErrors();
   return instrument;
 }
@@ -726,12 +726,12 @@ Instrument Loader::build() const {
   return instrument;
 }
 
-void Loader::checkVoices(const Instrument& instrument) {
+void Loader::checkVoices(const Instrument& instrument, double rate) {
   const auto refused = [this](std::string_view message, int note) { voiceError(message, note); };
   if (instrument.model == InstrumentModel::plate)
-    checkPlateVoices(instrument, refused);
+    checkPlateVoices(instrument, refused, rate);
   else
-    checkStringVoices(instrument, values_, refused);
+    checkStringVoices(instrument, values_, refused, rate);
 }
 
 // Points the voice's complaint at the setting behind the field it names, once per setting.

@@ -34,13 +34,19 @@ struct PresetOverride {
 // "NAME=VALUE" split at the first '=', blanks around each dropped; nothing without '=' or NAME.
 std::optional<PresetOverride> parseOverride(std::string_view argument);
 
+// The rate the loader prepares voices at to check a preset when the playing rate is not known.
+constexpr double kCheckRate = 48000.0;
+
 struct PresetOptions {
   // Prepare a voice for some keys and report what it refuses (a tuning with no solution, a grid
   // too coarse for the string or too fine for the plate): the lowest, the highest, every 12th key
   // from the lowest and every anchor of a string instrument; the lowest, reference and highest
-  // note of a plate. Made at 48 kHz, a few milliseconds a key (a large plate's more): a voice
+  // note of a plate. Made at checkRate, a few milliseconds a key (a large plate's more): a voice
   // prepared at another rate can still refuse a patch this check passed.
   bool checkVoices = true;
+  // The sample rate those voices are checked at: the one they will play at, where it is known
+  // (hamiltone-render's --sample-rate); the usual 48 kHz otherwise.
+  double checkRate = kCheckRate;
   // Set over the file, in order, each checked as a key of the file is (name, type, range, model)
   // and blamed by its "--set NAME=VALUE" in the messages. A per-key parameter set here holds at
   // every key: it replaces the file's value and the [[key]] anchors' — what a user comparing

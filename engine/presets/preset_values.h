@@ -15,9 +15,6 @@
 
 namespace hamiltone {
 
-// The rate the loader prepares voices at to check a preset (PresetOptions::checkVoices).
-constexpr double kCheckRate = 48000.0;
-
 // In the file, or the nth --set (n >= 1): those come after the file, in the order given.
 struct Place {
   int set = 0;

@@ -127,7 +127,8 @@ void buildStringKeys(const PresetValues& values, Instrument& instrument) {
 }
 
 void checkStringVoices(const Instrument& instrument, const PresetValues& values,
-                       const std::function<void(std::string_view message, int note)>& refused) {
+                       const std::function<void(std::string_view message, int note)>& refused,
+                       double rate) {
   const int lo = instrument.lowestNote, hi = instrument.highestNote;
   std::set<int> notes{lo, hi};
   for (int note = lo; note <= hi; note += 12) notes.insert(note);
@@ -139,11 +140,11 @@ void checkStringVoices(const Instrument& instrument, const PresetValues& values,
       double added = 0.0;  // the outermost strings' K_s, the middle one's taken as theirs
       for (int string : {0, key.unisons - 1}) {
         StringVoice voice;
-        voice.prepare(unisonPatch(instrument, note, string), note, kCheckRate);
+        voice.prepare(unisonPatch(instrument, note, string), note, rate);
         added += voice.coupling().selfStiffness() * key.unisons / 2.0;
       }
       if (key.bridge.mass > 0.0) {
-        const double k = 1.0 / (kCheckRate * key.patch.oversampling);
+        const double k = 1.0 / (rate * key.patch.oversampling);
         Bridge().prepare(key.bridge, k, added * std::pow(2.0, 2.0 * instrument.bendRange / 12.0));
       }
     } catch (const std::exception& e) {
@@ -151,7 +152,7 @@ void checkStringVoices(const Instrument& instrument, const PresetValues& values,
     }
   if (instrument.body.enabled) try {
       PianoBody body;
-      prepareBody(body, instrument, kCheckRate);
+      prepareBody(body, instrument, rate);
     } catch (const std::exception& e) {
       refused(e.what(), lo);
     }

@@ -419,6 +419,22 @@ TEST(PresetOverrides, ChangeWhatIsBuilt) {
   }
 }
 
+// The voices are checked at the rate they will play at when it is known: C8 on the longitudinal
+// grid is shorter than two of its segments at 48 kHz (h >= c_L k = 0.11 m) and fine at 384 kHz,
+// where hamiltone-render refused it all the same (hostile test), quoting 48 kHz's step.
+TEST(PresetOverrides, VoicesAreCheckedAtTheRateGiven) {
+  const std::string strings = sourcePath("presets/grand-piano-strings.toml");
+  const std::vector<PresetOverride> c8 = {{"scheme.grid_rule", "longitudinal"},
+                                          {"lowest_note", "C8"}};
+  try {
+    loadPreset(strings, {.overrides = c8});
+    ADD_FAILURE() << "C8 on the longitudinal grid accepted at 48 kHz";
+  } catch (const PresetError& e) {
+    EXPECT_NE(std::string(e.what()).find("k = 2.083e-05 s"), std::string::npos) << e.what();
+  }
+  EXPECT_NO_THROW(loadPreset(strings, {.checkRate = 384000.0, .overrides = c8}));
+}
+
 // A word may go without quotes where the row wants a word (choice, text) or a note name; a TOML
 // value is read as the file would read it, and quotes still work.
 TEST(PresetOverrides, ValuesAreWrittenAsInAFileOrAsBareWords) {
