@@ -263,6 +263,12 @@ int gridSegments(const StringPhysics& p, GridRule rule, double k, double sigma1,
 StringGrid stringGrid(const StringPhysics& p, GridRule rule, double k, double sigma1, double factor,
                       double tensionMargin) {
   if (rule != GridRule::twoGrid) {
+    // On the bound (44) itself the top mode sits at the Nyquist frequency, and a strike leaves it
+    // ringing: the transverse grid without a bend range (nothing else sizes it above the bound)
+    // put A0 at velocity 127 above 19 kHz at −10 dB of its peak; 2 % coarser, −48 dB
+    // (StringVoice.TheTransverseGridKeepsItsTopModeOffTheNyquistFrequency). The longitudinal grid
+    // is far from (44); the two grids have their margin.
+    if (rule == GridRule::transverse) factor = std::max(factor, kOffTheBound);
     const int m = gridSegments(p, rule, k, sigma1, factor);
     return {m, m};
   }

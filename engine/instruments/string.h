@@ -136,12 +136,16 @@ int gridSegments(const StringPhysics& physics, GridRule rule, double k, double s
 // 1/1.05 (SCHEMES §3b; at 1.43 the glide collapses to a quarter of the converged one).
 constexpr double kLongitudinalGridFactor = 1.05;
 
+// The transverse grid's least factor: on the bound (44) itself its top mode rings at the Nyquist
+// frequency (stringGrid).
+constexpr double kOffTheBound = 1.02;
+
 // The grids of `rule` (SCHEMES §3b for twoGrid). transverse and longitudinal: Mu = Mv =
-// gridSegments(). twoGrid: Mv = max(1, floor(L / (1.05 sqrt(E/ρ) k))); u's finest grid sized for
-// the design tension `tensionMargin`·T0 (stability needs T0, accuracy under tension modulation the
-// margin), coarsened by `factor`, then rounded down to a multiple r·Mv (with fewer coarse cells
-// where that keeps more of u's grid). Throws std::invalid_argument like gridSegments(), or for a
-// margin < 1.
+// gridSegments(), the transverse grid's factor at least kOffTheBound. twoGrid: Mv = max(1, floor(L
+// / (1.05 sqrt(E/ρ) k))); u's finest grid sized for the design tension `tensionMargin`·T0
+// (stability needs T0, accuracy under tension modulation the margin), coarsened by `factor`, then
+// rounded down to a multiple r·Mv (with fewer coarse cells where that keeps more of u's grid).
+// Throws std::invalid_argument like gridSegments(), or for a margin < 1.
 StringGrid stringGrid(const StringPhysics& physics, GridRule rule, double k, double sigma1,
                       double factor, double tensionMargin);
 

@@ -569,7 +569,9 @@ constexpr Parameter kTable[] = {
      .min = 1,
      .max = 100,
      .defaultText = "1",
-     .doc = "Grid spacing as a multiple of the finest stable one: above 1 is cheaper and duller."},
+     .doc = "Grid spacing as a multiple of the finest stable one: above 1 is cheaper and duller. "
+            "The transverse grid keeps at least 1.02 of its bound (times sqrt of the bend's "
+            "tension range): on the bound its top mode rings at the Nyquist frequency."},
     {.name = "scheme.grid_rule",
      .type = choice,
      .choices = "two-grid|transverse|longitudinal",

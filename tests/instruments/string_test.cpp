@@ -285,10 +285,12 @@ TEST(StringGrids, TwoGridsAreNestedAndSizedForTheDesignTension) {
   EXPECT_LE(cL * k / (p.length / grid.longitudinal), 1.0 / 1.05 + 1e-12);
   EXPECT_GT(gridSegments(p, GridRule::transverse, k, 0.0, 1.0), grid.transverse);
   EXPECT_EQ(NonlinearString(p, grid).size(), 130);
-  // The other rules keep one grid.
+  // The other rules keep one grid; the transverse one at least kOffTheBound off the bound.
   const StringGrid single = stringGrid(p, GridRule::transverse, k, 0.0, 1.0, 1.5);
   EXPECT_EQ(single.transverse, single.longitudinal);
-  EXPECT_EQ(single.transverse, gridSegments(p, GridRule::transverse, k, 0.0, 1.0));
+  EXPECT_EQ(single.transverse, gridSegments(p, GridRule::transverse, k, 0.0, kOffTheBound));
+  EXPECT_EQ(stringGrid(p, GridRule::transverse, k, 0.0, 1.12, 1.5).transverse,
+            gridSegments(p, GridRule::transverse, k, 0.0, 1.12));
   StringPhysics treble = p;
   treble.length = 0.9 * cL * k;  // 9.5 cm
   EXPECT_EQ(stringGrid(treble, GridRule::twoGrid, k, 0.0, 1.0, 1.5).longitudinal, 1);
