@@ -176,6 +176,13 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
           patch.detuneCents, "between −50 and 50 cents");
   const double target =
       equalTemperament(midiNote, patch.a4Hz) * std::pow(2.0, patch.detuneCents / 1200.0);
+  // Oversampling runs the string faster, but the output cannot carry a fundamental above its own
+  // Nyquist frequency: the decimator would fold it back, a wrong pitch (C8 at 8 kHz ×4: 3814 Hz).
+  if (!(target < 0.5 * sampleRate))
+    throw std::invalid_argument("target pitch = " + formatApprox(target, 6) +
+                                " Hz: must be below the output's Nyquist frequency " +
+                                formatApprox(0.5 * sampleRate, 6) +
+                                " Hz (a higher sample rate plays it; oversampling does not)");
   // The loss sets the grid (its σ1 tightens (44)) and the tuning sets the loss (ξ depends on T0):
   // two rounds settle both, σ1 being a small correction. The grid leaves room for the bend's
   // largest tension β: on the single grids h_min grows at most as sqrt(β) (minimalSpacing), so a

@@ -80,6 +80,28 @@ TEST(StringVoice, TheTransverseGridKeepsItsTopModeOffTheNyquistFrequency) {
   }
 }
 
+// A note whose fundamental is above the output's Nyquist frequency is refused at any oversampling:
+// run 4 times faster, C8 at 8 kHz came out folded to 3814 Hz (hostile test), where at ×1 the
+// tuning refused it. The message says what does play it.
+TEST(StringVoice, ANoteAboveTheOutputsNyquistFrequencyIsRefusedAtAnyOversampling) {
+  for (int oversampling : {1, 4}) {
+    StringPatch patch = piano(108);
+    patch.oversampling = oversampling;
+    StringVoice voice;
+    try {
+      voice.prepare(patch, 108, 8000.0);
+      ADD_FAILURE() << "C8 prepared at 8 kHz ×" << oversampling;
+    } catch (const std::invalid_argument& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("target pitch = 4186.01 Hz: must be below the output's Nyquist "
+                          "frequency 4000 Hz"),
+                std::string::npos)
+          << what;
+    }
+    EXPECT_NO_THROW(voice.prepare(patch, 108, 48000.0)) << "×" << oversampling;
+  }
+}
+
 // Lossless, every strike's energy stays: H + the caught hammer's energy = the injected energy,
 // over 2 s at 48 kHz (~1e5 steps; roundoff ~1e-16 per step per unknown, far below 1e-10).
 TEST(StringVoice, StrikesConserveEnergyExactly) {
