@@ -601,7 +601,7 @@ constexpr Parameter kTable[] = {
      .doc = "Gauge shift ε of the scalar auxiliary variable (BDZ §2.5). two-grid and "
             "longitudinal: 0.1 × the hardest strike's energy ½ M_H v_max² (any ε > 0 gives the "
             "converged glide; ε = 0 does not, from a displaced start); any value is accepted. "
-            "transverse, and two-grid on a string shorter than c_L k (C7 up at 48 kHz: one "
+            "transverse, and two-grid on a string shorter than c_L k (A#6 up at 48 kHz: one "
             "coarse cell that still does not resolve the longitudinal wave): 0, and at most 0.01 "
             "× that energy — a larger ε lets ψ drift and the output turns into noise."},
     {.name = "scheme.guard_energy_multiple",

@@ -87,14 +87,14 @@ double gaugeShift(const StringPatch& patch, const NonlinearString& string, doubl
              ? "oversampling " + std::to_string(enough) + " does, and accepts any ε"
              : std::string("no oversampling up to 64 does"));
   }
-  require(
-      epsilon >= 0.0 && epsilon <= most, "epsilon_j", epsilon,
-      "between 0 and " + formatApprox(most, 3) +
-          " J on this grid: its longitudinal Courant number c_L k/h = " + formatApprox(courant, 3) +
-          " exceeds 1, and a larger gauge shift lets ψ drift from sqrt(2(V'+ε)) until the "
-          "output is noise (at most a hundredth of the hardest strike's energy ½ M_H v_max² "
-          "= " +
-          formatApprox(strike, 3) + " J; " + remedy + ")");
+  require(epsilon >= 0.0 && epsilon <= most, "epsilon_j", epsilon,
+          "between 0 and " + formatApprox(most, 3) +
+              " J on this grid: its longitudinal Courant number c_L k/h = " +
+              formatApprox(courant, courant < 1.01 ? 6 : 3) +
+              " exceeds 1, and a larger gauge shift lets ψ drift from sqrt(2(V'+ε)) until the "
+              "output is noise (at most a hundredth of the hardest strike's energy ½ M_H v_max² "
+              "= " +
+              formatApprox(strike, 3) + " J; " + remedy + ")");
   return epsilon;
 }
 
