@@ -4,6 +4,7 @@
 #include <CLI/Config.hpp>
 #include <CLI/Formatter.hpp>
 #include <CLI/Validators.hpp>
+#include <algorithm>
 #include <cstdio>
 #include <exception>
 #include <string>
@@ -74,7 +75,10 @@ int run(const RenderArguments& a) {
           : static_cast<int>(parseInteger("--threads", a.threads, 1, Synth::kMaxThreads));
 
   // Everything is read and checked before the output file is created.
-  std::vector<Instrument> instruments = loadPresets(presets, a.sets, rate);
+  // Checked at the render's rate where it is above the usual 48 kHz (a grid fine enough there is
+  // not refused for 48 kHz's); below it, at 48 kHz, as keys the score does not play may not exist
+  // at a low rate (C8 above 8 kHz's Nyquist frequency): Synth::prepare refuses the played ones.
+  std::vector<Instrument> instruments = loadPresets(presets, a.sets, std::max(rate, kCheckRate));
   std::vector<TimedMessage> messages;
   double end = 0.0;
   if (!a.midi.empty()) {

@@ -570,8 +570,9 @@ constexpr Parameter kTable[] = {
      .max = 100,
      .defaultText = "1",
      .doc = "Grid spacing as a multiple of the finest stable one: above 1 is cheaper and duller. "
-            "The transverse grid keeps at least 1.02 of its bound (times sqrt of the bend's "
-            "tension range): on the bound its top mode rings at the Nyquist frequency."},
+            "The transverse grid keeps at least 1.02 of its bound (the bend range's sqrt of its "
+            "tension range, 1.12 at 2 semitones, is more): on the bound its top mode rings at the "
+            "Nyquist frequency."},
     {.name = "scheme.grid_rule",
      .type = choice,
      .choices = "two-grid|transverse|longitudinal",

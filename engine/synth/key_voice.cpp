@@ -125,8 +125,8 @@ void KeyVoice::process(size_t frames, double gain) noexcept {
     if (wasFading) length = std::min(length, static_cast<size_t>(fadeLeft_));
     render(done, length, gain);
     done += length;
-    if (wasFading && !fading()) {  // free the voices; a pending strike starts next round
-      if (freedAt_ < 0 && sounding()) freedAt_ = static_cast<long>(done);
+    if (wasFading && !fading()) {          // free the voices; a pending strike starts next round
+      freedAt_ = static_cast<long>(done);  // whether or not its strings fell quiet in the fade
       std::visit([](auto& v) { v.reset(); }, voice_);
       if (!pending()) break;
     }
@@ -141,12 +141,15 @@ void KeyVoice::render(size_t offset, size_t n, double gain) noexcept {
   float* left = outLeft_.data() + offset;
   float* right = outRight_.data() + offset;
   float* force = boardForce_.data() + offset;
+  // In a fade the key is freed where the fade ends (process): a quiet hold ending inside it would
+  // be seen in one piece and not in the next, as the blocks fall.
+  const bool inFade = fadeLeft_ > 0;
   std::span<float> mixL(mixLeft_.data(), n), mixR(mixRight_.data(), n);
   const float* bridge = nullptr;
   if (UnisonStrings* strings = std::get_if<UnisonStrings>(&voice_)) {
     strings->process(mixL, mixR);  // silence when no string sounds
     bridge = strings->boardForce().data();
-    if (strings->freedAt() >= 0 && freedAt_ < 0)
+    if (!inFade && strings->freedAt() >= 0 && freedAt_ < 0)
       freedAt_ = static_cast<long>(offset) + strings->freedAt();
   } else if (PlateVoice& plate = std::get<PlateVoice>(voice_); plate.active()) {
     plate.process(mixL, mixR);

@@ -49,8 +49,9 @@ class KeyVoice {
   // with the output); zeros for a key without a bridge.
   std::span<const float> boardForce() const { return {boardForce_.data(), frames_}; }
   // The sample of the last process() from which the key's bridged strings are silent and drive
-  // the board no more (they fell quiet, their fade ended, or the guard silenced them) with no
-  // strike after it in that piece; −1 otherwise. The same sample whatever the block size.
+  // the board no more — they fell quiet or the guard silenced them, or, in a fade, where the fade
+  // ended — with no strike after it in that piece; −1 otherwise. The same sample whatever the
+  // block size.
   long freedAt() const { return freedAt_; }
 
   bool sounding() const;  // a voice of the key is active

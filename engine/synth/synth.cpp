@@ -366,8 +366,9 @@ void Synth::render(std::span<float> left, std::span<float> right) noexcept {
 }
 
 // The body after the keys. What it does never depends on how the audio is cut into pieces: a key
-// leaves the sympathetic coupling when it is struck (an event, at its sample) and comes back when
-// the body rests; the dampers move at events; and the body goes to rest — exactly zero, so that
+// leaves the sympathetic coupling when it is struck (an event, at its sample) and comes back at
+// the sample its voice ends (KeyVoice::freedAt), or when the body rests; the dampers move at
+// events; and the body goes to rest — exactly zero, so that
 // stepping it or not is the same — only at multiples of kBodyRestCheck samples, once undriven and
 // under the voices' quiet floor (−100 dBFS at the output) for that long — or at once when the
 // 5 ms fade of a CC120 ends, which is an event's sample plus a fixed count.

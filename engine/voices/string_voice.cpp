@@ -80,12 +80,14 @@ double gaugeShift(const StringPatch& patch, const NonlinearString& string, doubl
   if (shortness > 1.0) {
     int enough = patch.oversampling;
     while (enough < 64 && enough < patch.oversampling * shortness) enough *= 2;
-    remedy =
-        "the string is shorter than c_L k, so the two grids' one coarse cell does not "
-        "resolve it either; " +
-        (enough >= patch.oversampling * shortness
-             ? "oversampling " + std::to_string(enough) + " does, and accepts any ε"
-             : std::string("no oversampling up to 64 does"));
+    const bool two = string.grid().longitudinal < string.grid().transverse;  // Mv = 1 < Mu
+    remedy = std::string("the string is shorter than c_L k, so ") +
+             (two ? "the two grids' one coarse cell does not resolve it either; "
+                  : "even the two grids' one coarse cell would not resolve it; ") +
+             (enough >= patch.oversampling * shortness
+                  ? std::string(two ? "" : "grid_rule \"two-grid\" at ") + "oversampling " +
+                        std::to_string(enough) + " does, and accepts any ε"
+                  : std::string("no oversampling up to 64 does"));
   }
   require(epsilon >= 0.0 && epsilon <= most, "epsilon_j", epsilon,
           "between 0 and " + formatApprox(most, 3) +

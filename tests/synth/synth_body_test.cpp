@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <numbers>
 #include <vector>
 
@@ -146,6 +147,44 @@ TEST(SynthBody, KeysPlayedEarlierRingInSympathyOnceTheirVoicesEnd) {
   while (first < other.left.size() && other.left[first] == warmed.left[first]) ++first;
   EXPECT_EQ(first, other.left.size()) << "blocks of 100 and 256 part at sample " << first;
   EXPECT_EQ(other.right, warmed.right);
+}
+
+// A key stolen while its voice is going quiet: its quiet hold ends inside the 5 ms steal fade.
+// Freed where the fade ends, whatever the blocks: in single frames the hold's end and the fade's
+// fall in different pieces, in one large block in the same one, and the two takes are the same
+// bits. (When the hold's end counted only in the piece that saw it, single frames left C3 out of
+// the sympathetic strings for good.) G3 steals it, held, and the pedal then lets C3 ring.
+TEST(SynthBody, AKeyStolenAsItGoesQuietRejoinsWhateverTheBlocks) {
+  auto synthWith = [](int polyphony) {
+    auto synth = std::make_unique<Synth>();
+    std::vector<bool> notes(128, false);
+    notes[48] = notes[55] = true;
+    synth->prepare({loadPreset(HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml")},
+                   {.sampleRate = kTakeRate, .maxBlock = 256, .notes = notes, .threads = 1});
+    synth->setPolyphony(polyphony);
+    return synth;
+  };
+  // Where C3, struck and released, falls quiet: the first frame with no voice sounding.
+  long quietAt = -1;
+  {
+    auto synth = synthWith(2);
+    testing::render(*synth, {{0.0, on(48, 90)}, {0.1, off(48)}}, 3.0, 1, [&](long frames) {
+      if (quietAt < 0 && frames > 4800 && synth->activeVoices() == 0) quietAt = frames;
+    });
+  }
+  ASSERT_GT(quietAt, 4800) << "C3 never fell quiet";
+  const double steal = static_cast<double>(quietAt - 96) / kTakeRate;  // 2 ms before: in the fade
+  const std::vector<TimedMessage> messages = {{0.0, on(48, 90)},
+                                              {0.1, off(48)},
+                                              {steal, on(55, 90)},
+                                              {steal + 0.1, cc(64, 127)}};
+  auto take = [&](int block) {
+    auto synth = synthWith(1);
+    return testing::render(*synth, messages, steal + 1.0, block);
+  };
+  const testing::Take frames = take(1), whole = take(4800);
+  EXPECT_EQ(frames.left, whole.left);
+  EXPECT_EQ(frames.right, whole.right);
 }
 
 // A staccato C4 with the pedal up: its voice dies under its damper (T60 0.51 s) and the body,

@@ -495,6 +495,17 @@ TEST(StringVoice, GaugeShiftDefaultsAndLimitsFollowTheGrid) {
               std::string::npos)
         << what;
   }
+  top.grid = GridRule::transverse;  // there two grids at ×4 resolve it, not oversampling alone
+  try {
+    voice.prepare(top, 108, 48000.0);
+    FAIL() << "epsilon 1 J accepted on C8's transverse grid";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("even the two grids' one coarse cell would not resolve "
+                                         "it; grid_rule \"two-grid\" at oversampling 4 does"),
+              std::string::npos)
+        << e.what();
+  }
+  top.grid = GridRule::twoGrid;
   top.oversampling = 4;
   top.epsilon.reset();
   voice.prepare(top, 108, 48000.0);
