@@ -149,7 +149,6 @@ void countEvent(const Cursor& track, std::size_t at, const TrackEvents& events) 
                        " channel messages and tempo changes; that is the most this reader accepts");
 }
 
-// The events of one track chunk, appended to `events`.
 // At one tick, tracks in order, each in its file order — except that a note-on waits while another
 // track's next event at that tick is a note-off: a key one track releases and another strikes at
 // the same tick then sounds, as a sequencer plays it (track order had the strike damped at once).
@@ -161,8 +160,8 @@ void noteOffsBeforeOtherTracksNoteOns(std::vector<TickedMessage>& m) {
   };
   std::vector<TickedMessage> merged;
   std::vector<std::size_t> next, end;  // per track of the tick: its events still to place
-  std::set<std::size_t> heads,
-      offHeads;  // tracks (by rank) with events left, and with a note-off next
+  // The tracks of the tick (by rank) with events left, and those with a note-off next.
+  std::set<std::size_t> heads, offHeads;
   for (std::size_t begin = 0; begin < m.size();) {
     std::size_t stop = begin + 1;
     while (stop < m.size() && m[stop].tick == m[begin].tick) ++stop;
@@ -195,6 +194,7 @@ void noteOffsBeforeOtherTracksNoteOns(std::vector<TickedMessage>& m) {
   }
 }
 
+// The events of one track chunk, appended to `events` with the track's index.
 void readTrack(Cursor track, int index, TrackEvents& events) {
   // A delta is < 2^28 and takes ≥ 2 bytes with its event, so in a file of ≤ 64 MiB the tick stays
   // below 2^53: no overflow, and exact as a double.

@@ -66,7 +66,7 @@ void Synth::prepare(std::vector<Instrument> instruments, const SynthSetup& setup
     const size_t count = instrument.keys.size();
     body->forces.assign(count, 0.0);
     body->driving.assign(count, nullptr);
-    body->rejoinAt.assign(count, -1);
+    body->rejoins.assign(count, {-1, 0});
     body->drivers.assign(count, 0);
     body->struck.assign(count, 0);
     body->excludedAt.assign(count, kNever);
@@ -375,6 +375,7 @@ void Synth::render(std::span<float> left, std::span<float> right) noexcept {
 void Synth::renderBody(size_t program, std::span<float> left, std::span<float> right) noexcept {
   Body& b = *bodies_[program];
   const int drivers = b.driverCount;
+  b.rejoinCount = 0;
   for (int d = 0; d < drivers; ++d) {
     const int key = b.drivers[d];
     const KeyVoice& v = voices_[program][key];
@@ -386,11 +387,11 @@ void Synth::renderBody(size_t program, std::span<float> left, std::span<float> r
     }
     // Fallen silent in this piece, and not struck again: from that sample its strings are the
     // body's again, at rest on the board, to ring in sympathy with the keys played after it.
-    b.rejoinAt[d] = v.busy() ? -1 : v.freedAt();
+    if (!v.busy() && v.freedAt() >= 0) b.rejoins[b.rejoinCount++] = {v.freedAt(), key};
   }
   auto rejoin = [&](long sample) {
-    for (int d = 0; d < drivers; ++d)
-      if (b.rejoinAt[d] == sample) b.body.setExcluded(b.drivers[d], false);
+    for (int r = 0; r < b.rejoinCount; ++r)
+      if (b.rejoins[r].first == sample) b.body.setExcluded(b.rejoins[r].second, false);
   };
   for (size_t key = 0; key < b.forces.size(); ++key) {
     const KeyVoice& v = voices_[program][key];
@@ -407,7 +408,7 @@ void Synth::renderBody(size_t program, std::span<float> left, std::span<float> r
     return;
   }
   for (size_t i = 0; i < left.size(); ++i) {
-    rejoin(static_cast<long>(i));
+    if (b.rejoinCount > 0) rejoin(static_cast<long>(i));
     bool pushed = false;
     for (int d = 0; d < drivers; ++d) {
       const double f = b.driving[d][i];
@@ -438,7 +439,7 @@ void Synth::renderBody(size_t program, std::span<float> left, std::span<float> r
                      b.clock - b.lastLoud >= kBodyRestCheck))
       rest(b);
   }
-  rejoin(static_cast<long>(left.size()));  // fallen silent with the piece's last sample
+  if (b.rejoinCount > 0) rejoin(static_cast<long>(left.size()));  // silent from the piece's end
 }
 
 // At rest, exactly; every key's strings back on the board — but those of a key struck in the

@@ -6,6 +6,7 @@
 
 #include <memory>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "instruments/piano_body.h"
@@ -130,9 +131,12 @@ class Synth {
     std::vector<double> forces;  // per key, this sample, N
     std::vector<int> drivers;    // the keys rendered this piece (driverCount), in order …
     int driverCount = 0;
-    std::vector<const float*> driving;  // … and their board forces …
-    std::vector<long> rejoinAt;  // … and the sample their strings come back to the board, or −1
-    std::vector<long> struck;    // per key, the strike (KeyVoice::order) it last saw …
+    std::vector<const float*> driving;  // … and their board forces
+    // The keys whose voices ended in this piece (rejoinCount) and the sample their strings come
+    // back to the board.
+    std::vector<std::pair<long, int>> rejoins;
+    int rejoinCount = 0;
+    std::vector<long> struck;           // per key, the strike (KeyVoice::order) it last saw …
     std::vector<long> excludedAt;       // … and `clock` then: left out of the coupling since
     std::vector<double> contact;        // per key, as last told (−1: not yet)
     double gain = 1.0;                  // body.gain times the instrument's

@@ -61,7 +61,8 @@ namespace {
 // strike's energy on, so ε is kept to a hundredth of it, 0 by default.
 double gaugeShift(const StringPatch& patch, const NonlinearString& string, double k) {
   const StringPhysics& p = string.physics();
-  const double courant = std::sqrt(p.young / p.density) * k / string.longitudinalSpacing();
+  const double cLk = std::sqrt(p.young / p.density) * k;
+  const double courant = cLk / string.longitudinalSpacing();
   const double strike = strikeEnergyScale(patch);
   if (courant <= 1.0) {
     const double epsilon = patch.epsilon.value_or(kEpsilonShare * strike);
@@ -75,7 +76,7 @@ double gaugeShift(const StringPatch& patch, const NonlinearString& string, doubl
   // one coarse cell is the whole string, and the mean stretch of this Kirchhoff–Carrier limit moves
   // faster than a step, so ψ drifts as on the transverse grid (measured, C7–C8: ε = 1 J is noise).
   // Only a shorter step resolves it.
-  const double shortness = std::sqrt(p.young / p.density) * k / p.length;  // c_L k / L
+  const double shortness = cLk / p.length;
   std::string remedy = "grid_rule \"two-grid\" accepts any ε";
   if (shortness > 1.0) {
     int enough = patch.oversampling;
