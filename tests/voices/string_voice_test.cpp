@@ -28,6 +28,16 @@ StringPatch lossless(int note) {
   return p;
 }
 
+// The message of the std::invalid_argument prepare() throws for `patch`, or "(accepted)".
+std::string refusalOf(const StringPatch& patch, int note, double rate = 48000.0) {
+  try {
+    StringVoice().prepare(patch, note, rate);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "(accepted)";
+}
+
 // Runs the voice for `seconds` in blocks; returns false if any sample was not finite.
 bool play(StringVoice& voice, double seconds, double rate, auto each) {
   std::vector<float> l(64), r(64);
@@ -87,18 +97,12 @@ TEST(StringVoice, ANoteAboveTheOutputsNyquistFrequencyIsRefusedAtAnyOversampling
   for (int oversampling : {1, 4}) {
     StringPatch patch = piano(108);
     patch.oversampling = oversampling;
-    StringVoice voice;
-    try {
-      voice.prepare(patch, 108, 8000.0);
-      ADD_FAILURE() << "C8 prepared at 8 kHz ×" << oversampling;
-    } catch (const std::invalid_argument& e) {
-      const std::string what = e.what();
-      EXPECT_NE(what.find("target pitch = 4186.01 Hz: must be below the output's Nyquist "
-                          "frequency 4000 Hz"),
-                std::string::npos)
-          << what;
-    }
-    EXPECT_NO_THROW(voice.prepare(patch, 108, 48000.0)) << "×" << oversampling;
+    const std::string what = refusalOf(patch, 108, 8000.0);
+    EXPECT_NE(what.find("target pitch = 4186.01 Hz: must be below the output's Nyquist "
+                        "frequency 4000 Hz"),
+              std::string::npos)
+        << "×" << oversampling << ": " << what;
+    EXPECT_EQ(refusalOf(patch, 108), "(accepted)") << "×" << oversampling;
   }
 }
 
@@ -483,28 +487,19 @@ TEST(StringVoice, GaugeShiftDefaultsAndLimitsFollowTheGrid) {
   ASSERT_EQ(voice.scheme().system().string().grid().longitudinal, 1);
   EXPECT_EQ(voice.scheme().parameters().epsilon, 0.0);
   top.epsilon = 1.0;
-  try {
-    voice.prepare(top, 108, 48000.0);
-    FAIL() << "epsilon 1 J accepted on C8's one coarse cell";
-  } catch (const std::invalid_argument& e) {
-    const std::string what = e.what();
-    EXPECT_EQ(what.rfind("epsilon_j = 1: must be between 0 and 0.0017 J on this grid", 0), 0)
-        << what;
-    EXPECT_NE(what.find("the string is shorter than c_L k, so the two grids' one coarse cell does "
-                        "not resolve it either; oversampling 4 does, and accepts any ε"),
-              std::string::npos)
-        << what;
-  }
+  const std::string twoGrids = refusalOf(top, 108);
+  EXPECT_EQ(twoGrids.rfind("epsilon_j = 1: must be between 0 and 0.0017 J on this grid", 0), 0)
+      << twoGrids;
+  EXPECT_NE(twoGrids.find("the string is shorter than c_L k, so the two grids' one coarse cell "
+                          "does not resolve it either; oversampling 4 does, and accepts any ε"),
+            std::string::npos)
+      << twoGrids;
   top.grid = GridRule::transverse;  // there two grids at ×4 resolve it, not oversampling alone
-  try {
-    voice.prepare(top, 108, 48000.0);
-    FAIL() << "epsilon 1 J accepted on C8's transverse grid";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("even the two grids' one coarse cell would not resolve "
-                                         "it; grid_rule \"two-grid\" at oversampling 4 does"),
-              std::string::npos)
-        << e.what();
-  }
+  const std::string transverse = refusalOf(top, 108);
+  EXPECT_NE(transverse.find("even the two grids' one coarse cell would not resolve it; grid_rule "
+                            "\"two-grid\" at oversampling 4 does"),
+            std::string::npos)
+      << transverse;
   top.grid = GridRule::twoGrid;
   top.oversampling = 4;
   top.epsilon.reset();
@@ -520,16 +515,11 @@ TEST(StringVoice, GaugeShiftDefaultsAndLimitsFollowTheGrid) {
   patch.epsilon = kUnresolvedEpsilonShare * strike;
   EXPECT_NO_THROW(voice.prepare(patch, 48, 48000.0));
   patch.epsilon = 300.0;
-  try {
-    voice.prepare(patch, 48, 48000.0);
-    FAIL() << "epsilon 300 J accepted on the transverse grid";
-  } catch (const std::invalid_argument& e) {
-    const std::string what = e.what();
-    EXPECT_EQ(what.rfind("epsilon_j = 300: must be between 0 and 0.0017 J on this grid", 0), 0)
-        << what;
-    EXPECT_NE(what.find("Courant number"), std::string::npos) << what;
-    EXPECT_NE(what.find("two-grid"), std::string::npos) << what;
-  }
+  const std::string what = refusalOf(patch, 48);
+  EXPECT_EQ(what.rfind("epsilon_j = 300: must be between 0 and 0.0017 J on this grid", 0), 0)
+      << what;
+  EXPECT_NE(what.find("Courant number"), std::string::npos) << what;
+  EXPECT_NE(what.find("two-grid"), std::string::npos) << what;
 }
 
 }  // namespace
