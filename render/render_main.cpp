@@ -64,7 +64,11 @@ int run(const RenderArguments& a) {
         "a .wav file");
   const double rate =
       static_cast<double>(parseInteger("--sample-rate", a.sampleRate, 8000, 384000));
-  const double tail = parseReal("--tail", a.tail, Range::nonNegative, " seconds");
+  if (type == FileType::ogg && rate > kOggMaxRate)
+    throw UsageError("--sample-rate " + a.sampleRate + ": Ogg Vorbis holds rates up to " +
+                     std::to_string(kOggMaxRate) + " Hz; use a lower rate, or -o a .wav or .flac " +
+                     "file");
+  const double tail = parseReal("--tail", a.tail, Range::nonNegative, "seconds");
   if (tail > 600.0) throw UsageError("--tail = " + a.tail + ": at most 600 seconds");
   const int block = static_cast<int>(parseInteger("--block", a.block, 1, 8192));
   const int voices =
@@ -106,7 +110,7 @@ int run(const RenderArguments& a) {
   for (const TimedMessage& m : messages)
     if (m.message.kind() == midi::noteOn) notes[m.message.data1 & 0x7F] = true;
   const std::string outside = unplayedNotes(messages, instruments);
-  if (!outside.empty() && !a.quiet)
+  if (!outside.empty())  // a warning, printed under --quiet too
     std::fprintf(stderr,
                  "hamiltone-render: warning: the preset in force does not play MIDI note(s)%s; "
                  "they are silent\n",
@@ -141,6 +145,9 @@ int run(const RenderArguments& a) {
                  limiterSummary(stats.limitedFrames, stats.overFrames, stats.limiterDeepestDb,
                                 stats.peakBeforeLimiter, MasterBus::kCeiling, rate)
                      .c_str());
+  } else if (stats.limitedFrames == 0 && !(stats.peakBeforeLimiter > 0.0)) {
+    std::fprintf(stderr, "hamiltone-render: warning: %s: the output is silent: every sample is 0\n",
+                 a.out.c_str());
   }
   return 0;
 }
@@ -182,7 +189,7 @@ int main(int argc, char** argv) {
   addNumberOption(&app, "--threads", a.threads, "N",
                   "threads rendering the keys, 1 … 256 (default: one per core); the file is the "
                   "same, bit for bit, whatever N");
-  app.add_flag("--quiet", a.quiet, "no progress bar and no summary");
+  app.add_flag("--quiet", a.quiet, "no progress bar and no summary; warnings are still printed");
   app.add_flag("--list-params", a.listParams,
                "print every preset parameter (name, type, unit, range, default) and exit");
   app.footer(

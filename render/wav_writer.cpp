@@ -1,14 +1,20 @@
-// libsndfile writes through the descriptor of an AtomicFile's temporary (sf_open_fd, which
-// leaves the descriptor to AtomicFile), so AtomicFile alone decides whether the file appears:
-// commit() renames it, the destructor and the signals that end the program remove it.
+// libsndfile writes through the descriptor of an AtomicFile's temporary, so AtomicFile alone
+// decides whether the file appears: commit() renames it, the destructor and the signals that end
+// the program remove it. It writes through our own calls (virtual I/O), which keep the first
+// error of any write: its FLAC and Vorbis encoders report success after a short write (a disk
+// that fills while the file is closed gave a truncated file and exit 0), so the writer cannot
+// trust libsndfile's own status.
 #include "wav_writer.h"
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <stdexcept>
 
@@ -49,9 +55,12 @@ int container(FileType type) {
 }
 
 // Checked in the member initialisers, with the rate and the channels.
-FileType checkedType(FileType type, SampleFormat format) {
+FileType checkedType(FileType type, SampleFormat format, int sampleRate) {
   if (type == FileType::flac && format == SampleFormat::float32)
     throw std::invalid_argument("FLAC holds integer samples: pcm16 or pcm24, not float32");
+  if (type == FileType::ogg && sampleRate > kOggMaxRate)
+    throw std::invalid_argument("Ogg Vorbis holds rates up to " + std::to_string(kOggMaxRate) +
+                                " Hz, not " + std::to_string(sampleRate));
   return type;
 }
 
@@ -71,6 +80,54 @@ float sanitised(float x) { return std::isfinite(x) ? std::clamp(x, -1.0f, 1.0f) 
 
 }  // namespace
 
+// libsndfile's virtual I/O on the temporary's descriptor, as sf_open_fd would use it, except that
+// a failed or short write is kept in ioError_.
+sf_count_t WavWriter::ioLength(void* self) {
+  struct stat st {};
+  return ::fstat(static_cast<WavWriter*>(self)->descriptor_, &st) == 0 ? st.st_size : -1;
+}
+
+sf_count_t WavWriter::ioSeek(sf_count_t offset, int whence, void* self) {
+  return ::lseek(static_cast<WavWriter*>(self)->descriptor_, offset, whence);
+}
+
+sf_count_t WavWriter::ioRead(void* to, sf_count_t bytes, void* self) {
+  const int fd = static_cast<WavWriter*>(self)->descriptor_;
+  sf_count_t done = 0;
+  while (done < bytes) {
+    const ssize_t n = ::read(fd, static_cast<char*>(to) + done, static_cast<size_t>(bytes - done));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    done += n;
+  }
+  return done;
+}
+
+sf_count_t WavWriter::ioWrite(const void* from, sf_count_t bytes, void* self) {
+  WavWriter& writer = *static_cast<WavWriter*>(self);
+  sf_count_t done = 0;
+  while (done < bytes) {
+    const ssize_t n = ::write(writer.descriptor_, static_cast<const char*>(from) + done,
+                              static_cast<size_t>(bytes - done));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      if (writer.ioError_ == 0) writer.ioError_ = n < 0 ? errno : EIO;
+      break;
+    }
+    done += n;
+  }
+  return done;
+}
+
+sf_count_t WavWriter::ioTell(void* self) {
+  return ::lseek(static_cast<WavWriter*>(self)->descriptor_, 0, SEEK_CUR);
+}
+
+std::string WavWriter::failure(const char* libsndfileSays) const {
+  return "writing " + path_ + " failed: " +
+         (ioError_ != 0 ? std::string(std::strerror(ioError_)) : std::string(libsndfileSays));
+}
+
 FileType fileTypeOf(const std::string& path, const std::string& flag) {
   std::string extension = std::filesystem::path(path).extension().string();
   for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
@@ -88,16 +145,20 @@ WavWriter::WavWriter(std::string path, const std::string& flag, int sampleRate, 
     : path_(std::move(path)),
       sampleRate_(checkedSampleRate(sampleRate)),
       channels_(checkedChannels(channels)),
-      type_(checkedType(type, format)),
+      type_(checkedType(type, format, sampleRate)),
       file_(path_, flag) {
   SF_INFO info{};
   info.samplerate = sampleRate_;
   info.channels = channels_;
   info.format = container(type_) | (type_ == FileType::ogg ? SF_FORMAT_VORBIS : subformat(format));
-  sound_ = sf_open_fd(fileno(file_.stream()), SFM_WRITE, &info, SF_FALSE);
+  descriptor_ = fileno(file_.stream());
+  SF_VIRTUAL_IO io{ioLength, ioSeek, ioRead, ioWrite, ioTell};
+  sound_ = sf_open_virtual(&io, SFM_WRITE, &info, this);
   if (!sound_)
-    throw std::runtime_error("cannot write " + path_ +
-                             ": libsndfile refuses the format: " + sf_strerror(nullptr));
+    throw std::runtime_error(
+        "cannot write " + path_ + ": " +
+        (ioError_ != 0 ? std::strerror(ioError_)
+                       : std::string("libsndfile refuses the format: ") + sf_strerror(nullptr)));
   // With clipping on, libsndfile saturates +1.0 — it scales by 2^15 (2^23 for 24-bit), one
   // step past the largest code — instead of wrapping it to -1. (It then rounds down, 1.2.0
   // measured: an error below one step, where without clipping it rounds to nearest.)
@@ -122,10 +183,10 @@ void WavWriter::write(const float* interleaved, std::size_t frames) {
     const std::size_t samples = n * static_cast<std::size_t>(channels_);
     std::transform(interleaved, interleaved + samples, chunk_.begin(), sanitised);
     const sf_count_t done = sf_writef_float(sound_, chunk_.data(), static_cast<sf_count_t>(n));
-    if (done != static_cast<sf_count_t>(n)) {
+    if (done != static_cast<sf_count_t>(n) || ioError_ != 0) {
       written_ += static_cast<std::size_t>(std::max<sf_count_t>(done, 0));
       failed_ = true;
-      throw std::runtime_error("writing " + path_ + " failed: " + sf_strerror(sound_));
+      throw std::runtime_error(failure(sf_strerror(sound_)));
     }
     written_ += n;
     interleaved += samples;
@@ -150,11 +211,12 @@ void WavWriter::commit() {
     if (end < 0 || ::ftruncate(fd, end) != 0)
       throw std::runtime_error("writing " + path_ + " failed: cannot cut it to the " +
                                std::to_string(written_) + " frames written");
+    ioError_ = 0;  // the data's failure is handled: what follows is the header's
   }
-  const int error = sf_close(sound_);  // writes the final header
+  const int error = sf_close(sound_);  // writes the encoder's last blocks and the final header
   sound_ = nullptr;
-  if (error != SF_ERR_NO_ERROR)
-    throw std::runtime_error("writing " + path_ + " failed: " + sf_error_number(error));
+  if (error != SF_ERR_NO_ERROR || ioError_ != 0)
+    throw std::runtime_error(failure(sf_error_number(error)));
   file_.commit();
 }
 

@@ -17,6 +17,8 @@ enum class SampleFormat { pcm16, pcm24, float32 };  // Ogg Vorbis, lossy, has no
 
 enum class FileType { wav, flac, ogg };
 
+constexpr int kOggMaxRate = 200000;  // Hz: the highest libsndfile's Vorbis encoder takes
+
 // The type the extension of `path` names, in any case: .wav, .flac, .ogg. UsageError naming `flag`,
 // the path and its extension, and listing the valid ones, for any other extension or none.
 FileType fileTypeOf(const std::string& path, const std::string& flag);
@@ -25,9 +27,9 @@ class WavWriter {
  public:
   // Creates the temporary beside `path` now (see AtomicFile), so a bad path fails before any
   // rendering: UsageError naming `flag` for an empty path, a directory, a device or an
-  // unwritable directory; std::invalid_argument for a sample rate <= 0, channels not 1 or 2, or
-  // FLAC in float32 (FLAC holds integers); std::runtime_error naming the path if libsndfile
-  // refuses the format.
+  // unwritable directory; std::invalid_argument for a sample rate <= 0 (or above kOggMaxRate for
+  // Ogg), channels not 1 or 2, or FLAC in float32 (FLAC holds integers); std::runtime_error naming
+  // the path if libsndfile refuses the format.
   WavWriter(std::string path, const std::string& flag, int sampleRate, int channels,
             SampleFormat format, FileType type = FileType::wav);
   ~WavWriter();  // closes and removes the temporary unless committed
@@ -38,10 +40,13 @@ class WavWriter {
   // the rest is clamped to [-1, 1] — so one bad sample cannot wrap around in PCM or put a NaN
   // or a value past full scale in a float file. Copies through a buffer sized once in the
   // constructor, so a call allocates nothing.
-  // Throws std::runtime_error naming the path and libsndfile's message (a full disk); the frames
-  // written before the failure are kept, and framesWritten() counts them.
+  // Throws std::runtime_error naming the path and the write's error ("No space left on device"),
+  // or libsndfile's message; the frames written before the failure are kept, and framesWritten()
+  // counts them.
   void write(const float* interleaved, std::size_t frames);
-  // Writes the header, closes and renames onto the path; throws std::runtime_error on an error.
+  // Writes the encoder's last blocks and the header, closes and renames onto the path; throws
+  // std::runtime_error naming the path and the error if any write of the file failed or fell
+  // short, even one libsndfile took as done (its FLAC and Vorbis encoders do).
   // After a failed write() a WAV is cut to framesWritten() whole frames first, so what appears
   // is a valid WAV of what was written before the failure; a compressed file cannot be cut, so
   // then commit() throws and nothing appears.
@@ -58,7 +63,16 @@ class WavWriter {
   int sampleRate_, channels_;
   FileType type_;
   AtomicFile file_;
-  SNDFILE* sound_ = nullptr;  // writes through the temporary's descriptor
+  SNDFILE* sound_ = nullptr;  // writes through the temporary's descriptor, by the calls below
+  int descriptor_ = -1;       // the temporary's
+  int ioError_ = 0;           // errno of the first write that failed or fell short; 0: none
+  static sf_count_t ioLength(void* self);
+  static sf_count_t ioSeek(sf_count_t offset, int whence, void* self);
+  static sf_count_t ioRead(void* to, sf_count_t bytes, void* self);
+  static sf_count_t ioWrite(const void* from, sf_count_t bytes, void* self);
+  static sf_count_t ioTell(void* self);
+  // "writing PATH failed: " and the write's error, or libsndfile's message if no write failed.
+  std::string failure(const char* libsndfileSays) const;
   std::vector<float> chunk_;  // sanitised samples on their way to libsndfile
   std::size_t written_ = 0;   // whole frames libsndfile took
   bool failed_ = false;       // a write() failed: the file may end in part of a frame

@@ -317,6 +317,33 @@ TEST_F(RenderCli, AnUnstablePresetIsAnErrorAndWritesNothing) {
     EXPECT_EQ(entry.path().filename().string().find("out.wav"), std::string::npos);
 }
 
+// --quiet drops the progress bar and the summary, not the warnings: a render whose only note the
+// preset does not play is silent, and says so (under --quiet it once printed nothing, exit 0).
+TEST_F(RenderCli, QuietStillWarnsOfUnplayedNotesAndASilentOutput) {
+  const Result r = run("--preset " + preset("paper-c3-string") + " --notes G9:100:0.1 --tail 0.1" +
+                       " --quiet -o " + wav());
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.err.find("does not play MIDI note(s) 127"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("the output is silent"), std::string::npos) << r.err;
+}
+
+// Ogg Vorbis holds rates up to 200 kHz: a higher one is refused before rendering, naming the rate
+// and the formats that hold it (it failed at the first write, exit 1, "Format not recognised").
+TEST_F(RenderCli, OggAboveItsHighestRateIsRefusedBeforeRendering) {
+  const std::string ogg = (dir_ / "out.ogg").string();
+  const Result r = run("--preset " + preset("paper-c3-string") +
+                       " --notes C3:100:0.1 --sample-rate 200001 --quiet -o " + ogg);
+  EXPECT_EQ(r.exitCode, 2) << r.err;
+  EXPECT_NE(r.err.find("200001"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("200000"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(".flac"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(ogg));
+  EXPECT_EQ(run("--preset " + preset("paper-c3-string") +
+                " --notes C3:100:0.1 --tail 0 --sample-rate 200000 --quiet -o " + ogg)
+                .exitCode,
+            0);
+}
+
 // A full disk is an I/O error: exit 1, the message names the file, and neither it nor a temporary
 // is left (docs/failure-behaviour.md). 1 s of pcm24 stereo is 288 kB, more than the 64 KiB disk.
 TEST_F(RenderCli, AFullDiskIsAnIoErrorAndLeavesNoFile) {

@@ -3,13 +3,16 @@
 // partial, is left unless committed; and the extension of a path names its type.
 #include "wav_writer.h"
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <sndfile.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cmath>
 #include <csignal>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -55,6 +58,17 @@ std::vector<std::string> listing(const fs::path& dir) {
   std::vector<std::string> names;
   for (const auto& entry : fs::directory_iterator(dir)) names.push_back(entry.path().filename());
   return names;
+}
+
+// The descriptor this process holds on path's temporary (PATH.tmp-PID-XXXXXX); -1 if none.
+int temporaryDescriptor(const fs::path& path) {
+  for (const auto& entry : fs::directory_iterator("/proc/self/fd")) {
+    std::error_code error;
+    const std::string target = fs::read_symlink(entry.path(), error).string();
+    if (!error && target.rfind(path.string() + ".tmp-", 0) == 0)
+      return std::stoi(entry.path().filename().string());
+  }
+  return -1;
 }
 
 // A 440 Hz tone, interleaved; the channels differ (sine, half-amplitude cosine) so a swapped
@@ -205,6 +219,34 @@ TEST_F(WavWriterTest, CommitReplacesAnExistingFile) {
   writer.commit();
   EXPECT_EQ(readBack(wav()).info.frames, static_cast<sf_count_t>(kSanitised.size()));
   EXPECT_EQ(listing(dir_).size(), 1u);
+}
+
+// The disk fills as the file is closed: the encoders' last blocks (FLAC, Vorbis) or the header
+// (WAV) cannot be written. libsndfile's FLAC and Vorbis encoders report success then (a render
+// exited 0 with a truncated FLAC); commit() must throw, naming the file and the system's error,
+// and leave nothing. The temporary's descriptor is made /dev/full after the samples are written.
+TEST_F(WavWriterTest, AWriteThatFailsAsTheFileClosesLeavesNoFile) {
+  const int full = ::open("/dev/full", O_WRONLY);
+  if (full < 0) GTEST_SKIP() << "no /dev/full";
+  const std::vector<float> tone = testTone(4000, 48000, 1);
+  for (const auto& [name, type, format] :
+       {std::tuple{"out.wav", FileType::wav, SampleFormat::pcm16},
+        std::tuple{"out.flac", FileType::flac, SampleFormat::pcm16},
+        std::tuple{"out.ogg", FileType::ogg, SampleFormat::pcm16}}) {
+    const fs::path path = dir_ / name;
+    WavWriter writer(path.string(), "-o", 48000, 1, format, type);
+    writer.write(tone.data(), tone.size());
+    ASSERT_GE(::dup2(full, temporaryDescriptor(path)), 0) << name;
+    try {
+      writer.commit();
+      ADD_FAILURE() << name << ": committed a file whose last write failed";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(path.string()), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(std::strerror(ENOSPC)), std::string::npos) << e.what();
+    }
+  }
+  ::close(full);
+  EXPECT_TRUE(listing(dir_).empty());
 }
 
 TEST_F(WavWriterTest, SignalRemovesTheTemporary) {
