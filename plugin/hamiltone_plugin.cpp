@@ -16,6 +16,14 @@ namespace {
 
 using namespace hamiltone::plugin;
 
+// A parameter's default and range, as DPF takes them.
+struct Range {
+  float def, min, max;
+};
+constexpr Range range(const hamiltone::plugin::ControlRange& r) {
+  return {static_cast<float>(r.def), static_cast<float>(r.min), static_cast<float>(r.max)};
+}
+
 class HamiltonePlugin : public Plugin {
  public:
   HamiltonePlugin() : Plugin(kParameterCount, 0, kStateCount) {
@@ -77,7 +85,12 @@ class HamiltonePlugin : public Plugin {
   void setParameterValue(uint32_t index, float value) override {
     if (index >= kStatus) return;
     values_[index].store(value, std::memory_order_relaxed);
-    if (index == kPreset) loader_.setBundled(static_cast<int>(std::lround(value)));
+    // An index out of range is refused by the loader, naming it: held within ±1e9 so that it
+    // reaches the loader as sent rather than wrapped (1e10 was logged as preset 1410065408).
+    if (index == kPreset)
+      loader_.setBundled(std::isnan(value) ? -1
+                                           : static_cast<int>(std::clamp(
+                                                 std::lround(value), -1000000000L, 1000000000L)));
   }
 
   // Not the audio thread (DPF calls it from the host's main or worker thread).
@@ -101,10 +114,11 @@ class HamiltonePlugin : public Plugin {
   void run(const float**, float** outputs, uint32_t frames, const MidiEvent* midiEvents,
            uint32_t midiEventCount) override {
     const auto value = [this](unsigned i) { return values_[i].load(std::memory_order_relaxed); };
-    playing_.setControls({.gainDb = value(kGainDb),
-                          .velocityCurve = value(kVelocityCurve),
-                          .damperScale = value(kDamperScale),
-                          .polyphony = static_cast<int>(std::lround(value(kPolyphony)))});
+    playing_.setControls(
+        {.gainDb = value(kGainDb),
+         .velocityCurve = value(kVelocityCurve),
+         .damperScale = value(kDamperScale),
+         .polyphony = static_cast<int>(std::lround(kPolyphonyRange.held(value(kPolyphony))))});
     playing_.process(std::span(outputs[0], frames), std::span(outputs[1], frames),
                      std::span(midiEvents, midiEventCount));
   }
@@ -114,24 +128,33 @@ class HamiltonePlugin : public Plugin {
   struct Description {
     uint32_t hints;
     const char *name, *symbol, *unit;
-    float def, min, max;
+    Range range;
     const char* description;
   };
   static constexpr uint32_t kKnob = kParameterIsAutomatable;
   static constexpr Description kDescriptions[kParameterCount] = {
-      {kKnob | kParameterIsInteger, "Preset", "preset", "", 0.0f, 0.0f, 0.0f,
+      {kKnob | kParameterIsInteger,
+       "Preset",
+       "preset",
+       "",
+       {0.0f, 0.0f, 0.0f},
        "The bundled instrument (the preset_file state, when set, plays instead)."},
-      {kKnob, "Gain", "gain", "dB", 0.0f, -60.0f, 12.0f,
+      {kKnob, "Gain", "gain", "dB", range(kGainDbRange),
        "Output level, after the instrument's own limiter."},
-      {kKnob | kParameterIsLogarithmic, "Velocity curve", "velocity_curve", "", 1.0f, 0.25f, 4.0f,
+      {kKnob | kParameterIsLogarithmic, "Velocity curve", "velocity_curve", "",
+       range(kVelocityCurveRange),
        "Key velocity v becomes 127 (v/127)^curve: above 1 the keyboard plays softer (harder to "
        "reach forte), below 1 louder."},
-      {kKnob | kParameterIsLogarithmic, "Damper decay", "damper", "", 1.0f, 0.25f, 4.0f,
+      {kKnob | kParameterIsLogarithmic, "Damper decay", "damper", "", range(kDamperScaleRange),
        "How long a released key rings, as a multiple of the preset's damper decay time (T60), "
        "for the keys released after it changes."},
-      {kKnob | kParameterIsInteger, "Polyphony", "polyphony", "", 0.0f, 0.0f, 64.0f,
+      {kKnob | kParameterIsInteger, "Polyphony", "polyphony", "", range(kPolyphonyRange),
        "Keys sounding at once (each costs CPU); 0: the preset's own."},
-      {kParameterIsOutput | kParameterIsInteger, "Status", "status", "", 0.0f, 0.0f, 2.0f,
+      {kParameterIsOutput | kParameterIsInteger,
+       "Status",
+       "status",
+       "",
+       {0.0f, 0.0f, 2.0f},
        "0 loading, 1 ready, 2 the preset or overrides were refused (the reason is on stderr; the "
        "instrument before plays on)."},
   };
@@ -152,7 +175,7 @@ class HamiltonePlugin : public Plugin {
     p.symbol = d.symbol;
     p.unit = d.unit;
     p.description = d.description;
-    p.ranges = {d.def, d.min, d.max};
+    p.ranges = {d.range.def, d.range.min, d.range.max};
     if (index == kPreset) {
       const auto presets = bundledPresets();
       std::vector<const char*> names;

@@ -19,7 +19,11 @@ void PlayingSynth::release() {
   current_ = outgoing_ = nullptr;
 }
 
-void PlayingSynth::setControls(const Controls& controls) noexcept {
+void PlayingSynth::setControls(const Controls& asked) noexcept {
+  const Controls controls{.gainDb = kGainDbRange.held(asked.gainDb),
+                          .velocityCurve = kVelocityCurveRange.held(asked.velocityCurve),
+                          .damperScale = kDamperScaleRange.held(asked.damperScale),
+                          .polyphony = static_cast<int>(kPolyphonyRange.held(asked.polyphony))};
   if (controls == controls_) return;
   controls_ = controls;
   gainTarget_ = std::pow(10.0, controls_.gainDb / 20.0);

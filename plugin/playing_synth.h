@@ -30,6 +30,18 @@ struct Controls {
   bool operator==(const Controls&) const = default;
 };
 
+// The controls' ranges, as the plugin declares them. A host may send any float (jalv's console,
+// a hand-edited session): setControls keeps every value inside its range and takes NaN as the
+// default — a gain of +1000 dB once made the output infinite, then NaN for good.
+struct ControlRange {
+  double min, max, def;
+  double held(double value) const { return std::isnan(value) ? def : std::clamp(value, min, max); }
+};
+inline constexpr ControlRange kGainDbRange{-60.0, 12.0, 0.0};
+inline constexpr ControlRange kVelocityCurveRange{0.25, 4.0, 1.0};
+inline constexpr ControlRange kDamperScaleRange{0.25, 4.0, 1.0};
+inline constexpr ControlRange kPolyphonyRange{0.0, 64.0, 0.0};
+
 // 127·(v/127)^curve, rounded, kept within 1 … 127 (0 would be a note-off).
 inline int curvedVelocity(int velocity, double curve) {
   const double v = 127.0 * std::pow(velocity / 127.0, curve);

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <thread>
 #include <vector>
 
@@ -111,6 +112,29 @@ TEST_F(PlayingSynthTest, GainFollowsItsControlSmoothly) {
   // own decay); after 90 ms it is at the target's −60 dB (e^−9 = 1.2e−4 of the way left).
   EXPECT_GT(fading.peak(0, 240), 0.5f * before);
   EXPECT_LT(fading.peak(4320), 2e-3f * before);
+}
+
+// A host may send any float: a gain of +1000 dB made the output infinite and, once the smoothing
+// met inf − inf, NaN for good (hostile test in jalv). Every control is held in its declared range
+// and NaN is its default: +1000 dB plays as +12 dB, and the gain comes back when set back.
+TEST_F(PlayingSynthTest, ControlsOutsideTheirRangesAreHeldInside) {
+  play(playing_, 256, {{0, 3, {0x90, 69, 110}}});
+  const float before = play(playing_, 4800).peak();
+  const double inf = std::numeric_limits<double>::infinity();
+  for (const double wild : {1000.0, 1e30, inf, -inf, std::numeric_limits<double>::quiet_NaN()}) {
+    playing_.setControls(
+        {.gainDb = wild, .velocityCurve = wild, .damperScale = wild, .polyphony = 1 << 30});
+    const Block loud = play(playing_, 4800);
+    for (const float x : loud.left) ASSERT_TRUE(std::isfinite(x)) << wild;
+    // +12 dB at most (4×), and the master's limiter sits before the gain.
+    EXPECT_LE(loud.peak(), 4.0f) << wild;
+  }
+  playing_.setControls({});
+  play(playing_, 4800);
+  const Block back = play(playing_, 4800);
+  for (const float x : back.left) ASSERT_TRUE(std::isfinite(x));
+  EXPECT_GT(back.peak(), 0.05f * before);
+  EXPECT_LT(back.peak(), 1.0f);
 }
 
 }  // namespace
