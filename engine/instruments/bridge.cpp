@@ -54,28 +54,37 @@ void Bridge::prepare(const BridgePhysics& p, double k, double addedStiffness) {
 }
 
 void Bridge::reset() noexcept {
-  w0_ = w1_ = 0.0;
+  w0_ = w1_ = d0_ = d1_ = 0.0;
   dissipated_ = supplied_ = 0.0;
 }
 
-double Bridge::step(double force, double drive) noexcept {
+double Bridge::advance(double& before, double& now, double force) noexcept {
   const double next =
-      (2.0 * w1_ - down_ * w0_ + kkOverM_ * (force + drive - physics_.stiffness * w1_)) / up_;
-  const double velocity = (next - w0_) / (2.0 * k_);  // δt· w
+      (2.0 * now - down_ * before + kkOverM_ * (force - physics_.stiffness * now)) / up_;
+  const double velocity = (next - before) / (2.0 * k_);  // δt· w
   dissipated_ += physics_.resistance * k_ * velocity * velocity;
-  supplied_ += drive * k_ * velocity;  // D^n (w^{n+1} − w^{n−1})/2
-  w0_ = w1_;
-  w1_ = next;
-  return next;
+  before = now;
+  now = next;
+  return velocity;
 }
 
-double Bridge::energy() const {
-  const double velocity = (w1_ - w0_) / k_;
-  return 0.5 * physics_.mass * velocity * velocity + 0.5 * physics_.stiffness * w1_ * w0_;
+double Bridge::step(double force, double drive) noexcept {
+  advance(w0_, w1_, force);
+  const double velocity = advance(d0_, d1_, drive);
+  supplied_ += drive * k_ * velocity;  // D^n (w_D^{n+1} − w_D^{n−1})/2
+  return w1_;
 }
+
+double Bridge::partEnergy(double before, double now) const {
+  const double velocity = (now - before) / k_;
+  return 0.5 * physics_.mass * velocity * velocity + 0.5 * physics_.stiffness * now * before;
+}
+
+double Bridge::energy() const { return partEnergy(w0_, w1_) + partEnergy(d0_, d1_); }
 
 double Bridge::forceOnBoard() const {
-  return physics_.stiffness * w1_ + physics_.resistance * (w1_ - w0_) / k_;
+  const double w = w1_ + d1_, before = w0_ + d0_;
+  return physics_.stiffness * w + physics_.resistance * (w - before) / k_;
 }
 
 }  // namespace hamiltone

@@ -70,8 +70,14 @@ class BridgeCoupling {
 // which the strings do not feel back (w does not enter their V': a neglected reaction of order
 // EA sin²α / L, 40 to 400 N/m a string at 1° from bass to treble, against the bridges' 1e5 to
 // 7e5) — its work tallied in supplied().
+// The equation being linear, w = w_F + w_D, each part the response to F or D alone, and each
+// keeps its own balance above. The strings' ends follow w_F only, the board takes both: the motion
+// D drives is passed on, not back. Letting the strings feel w_D too — half of D's reaction without
+// the other half — closed a loop that is not passive (tension change → w_D → the strings' ends →
+// their tension change): A0 at velocity 127 on grand-piano then rang at −65 dBFS for good after
+// its release, a steady longitudinal mode (465.75 Hz and its harmonics), at 0.5° as at 1°.
 // Levels as the scheme's: after a step it holds w^n and w^{n+1}; the strings' next step takes
-// w^{n+1}, current(), and so does the force of the bridge's next step.
+// w_F^{n+1}, current(), and so does the force of the bridge's next step.
 class Bridge {
  public:
   // Throws std::invalid_argument naming the field if a value is not finite and >= 0 (mass > 0),
@@ -80,22 +86,27 @@ class Bridge {
   void prepare(const BridgePhysics& physics, double k, double addedStiffness);
   void reset() noexcept;
 
-  double current() const { return w1_; }  // w at the level the next steps' forces use
+  double current() const { return w1_; }             // w_F at the level the next steps' forces use
+  double displacement() const { return w1_ + d1_; }  // w = w_F + w_D there: what the board takes
   // One step under the force F (the strings' pull, at level current()) and the drive D. Returns
-  // w^{n+1}.
+  // w_F^{n+1}.
   double step(double force, double drive = 0.0) noexcept;
 
-  double energy() const;  // H^{n+½} of the bridge alone
+  double energy() const;  // H^{n+½} of the bridge alone: of w_F and of w_D
   double dissipated() const { return dissipated_; }
   double supplied() const { return supplied_; }  // the drives' work since reset(), J
-  // What the bridge passes on to the soundboard at the last level: K_b w + R_b ẇ.
+  // What the bridge passes on to the soundboard at the last level: K_b w + R_b ẇ, w = w_F + w_D.
   double forceOnBoard() const;
   const BridgePhysics& physics() const { return physics_; }
 
  private:
   BridgePhysics physics_;
   double k_ = 0.0, up_ = 1.0, down_ = 1.0, kkOverM_ = 0.0;
-  double w0_ = 0.0, w1_ = 0.0;  // w^n, w^{n+1}
+  double w0_ = 0.0, w1_ = 0.0;  // w_F^n, w_F^{n+1}
+  double d0_ = 0.0, d1_ = 0.0;  // w_D^n, w_D^{n+1}
+  // One step of either part under its force, its losses added to dissipated_.
+  double advance(double& before, double& now, double force) noexcept;
+  double partEnergy(double before, double now) const;
   double dissipated_ = 0.0, supplied_ = 0.0;
 };
 

@@ -174,10 +174,8 @@ TEST(SynthBody, AKeyStolenAsItGoesQuietRejoinsWhateverTheBlocks) {
   }
   ASSERT_GT(quietAt, 4800) << "C3 never fell quiet";
   const double steal = static_cast<double>(quietAt - 96) / kTakeRate;  // 2 ms before: in the fade
-  const std::vector<TimedMessage> messages = {{0.0, on(48, 90)},
-                                              {0.1, off(48)},
-                                              {steal, on(55, 90)},
-                                              {steal + 0.1, cc(64, 127)}};
+  const std::vector<TimedMessage> messages = {
+      {0.0, on(48, 90)}, {0.1, off(48)}, {steal, on(55, 90)}, {steal + 0.1, cc(64, 127)}};
   auto take = [&](int block) {
     auto synth = synthWith(1);
     return testing::render(*synth, messages, steal + 1.0, block);
@@ -208,6 +206,28 @@ TEST(SynthBody, AStaccatoNoteLeavesTheWholePianoSilentSoonAfter) {
   const double after = static_cast<double>(silentAt) / kTakeRate - release;
   std::printf("silent %.2f s after the release\n", after);
   EXPECT_LT(after, 2.5);
+}
+
+// A fortissimo A0, released after 1 s, dies away and leaves the piano silent. Its tension change
+// drives the bridge through the 1° angle; when the strings' ends followed that motion too, the
+// loop was not passive and a longitudinal mode (465.75 Hz) rang at −65 dBFS for good: the voice
+// was never freed, and the live player never exited after a score (hostile test; bridge.h).
+// Measured since: silent 4.55 s after the release. The bound is the failure's (never), not a
+// damper's time.
+TEST(SynthBody, AFortissimoBassNoteDiesAwayAfterItsRelease) {
+  Synth synth;
+  std::vector<bool> notes(128, false);
+  notes[21] = true;
+  synth.prepare({loadPreset(HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml")},
+                {.sampleRate = kTakeRate, .maxBlock = 256, .notes = notes, .threads = 1});
+  const double release = 1.0;
+  long silentAt = -1;
+  testing::render(synth, {{0.0, on(21, 127)}, {release, off(21)}}, 8.0, 256, [&](long frames) {
+    if (silentAt < 0 && synth.silent()) silentAt = frames;
+  });
+  ASSERT_GT(silentAt, 0) << "still sounding 7 s after the release";
+  std::printf("silent %.2f s after the release\n",
+              static_cast<double>(silentAt) / kTakeRate - release);
 }
 
 // CC120 (all sound off) silences the body with the voices: a pedalled chord rings on the board
