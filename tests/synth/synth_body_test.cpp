@@ -48,6 +48,26 @@ double bandPower(const std::vector<double>& x, double hz) {
   return 2.0 * (re * re + im * im) / (n * n);  // a sinusoid's A²/2
 }
 
+// One key of grand-piano struck at `velocity`, released after 1 s: the seconds from the release
+// until the whole piano (voices and body) is silent, printed; −1 if it still sounds at `seconds`.
+double silentAfterRelease(int note, int velocity, double seconds) {
+  Synth synth;
+  std::vector<bool> notes(128, false);
+  notes[note] = true;
+  synth.prepare({loadPreset(HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml")},
+                {.sampleRate = kTakeRate, .maxBlock = 256, .notes = notes, .threads = 1});
+  const double release = 1.0;
+  long silentAt = -1;
+  testing::render(synth, {{0.0, on(note, velocity)}, {release, off(note)}}, seconds, 256,
+                  [&](long frames) {
+                    if (silentAt < 0 && synth.silent()) silentAt = frames;
+                  });
+  if (silentAt < 0) return -1.0;
+  const double after = static_cast<double>(silentAt) / kTakeRate - release;
+  std::printf("note %d, velocity %d: silent %.2f s after the release\n", note, velocity, after);
+  return after;
+}
+
 TEST(SynthBody, ThePedalLetsTheOtherStringsRingInSympathy) {
   const double seconds = 2.5;
   const size_t from = static_cast<size_t>(0.5 * kTakeRate);
@@ -192,19 +212,8 @@ TEST(SynthBody, AKeyStolenAsItGoesQuietRejoinsWhateverTheBlocks) {
 // 1.6 s, and the body rests at the next 4096-sample check. Measured: silent 1.1 s after the
 // release (8.5 s when a damper could lower a string's loss, docs: SympatheticStrings).
 TEST(SynthBody, AStaccatoNoteLeavesTheWholePianoSilentSoonAfter) {
-  Synth synth;
-  std::vector<bool> notes(128, false);
-  notes[60] = true;
-  synth.prepare({loadPreset(HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml")},
-                {.sampleRate = kTakeRate, .maxBlock = 256, .notes = notes, .threads = 1});
-  const double release = 1.0;
-  long silentAt = -1;
-  testing::render(synth, {{0.0, on(60, 100)}, {release, off(60)}}, 6.0, 256, [&](long frames) {
-    if (silentAt < 0 && synth.silent()) silentAt = frames;
-  });
-  ASSERT_GT(silentAt, 0) << "still sounding 5 s after the release";
-  const double after = static_cast<double>(silentAt) / kTakeRate - release;
-  std::printf("silent %.2f s after the release\n", after);
+  const double after = silentAfterRelease(60, 100, 6.0);
+  ASSERT_GT(after, 0.0) << "still sounding 5 s after the release";
   EXPECT_LT(after, 2.5);
 }
 
@@ -215,19 +224,7 @@ TEST(SynthBody, AStaccatoNoteLeavesTheWholePianoSilentSoonAfter) {
 // Measured since: silent 4.55 s after the release. The bound is the failure's (never), not a
 // damper's time.
 TEST(SynthBody, AFortissimoBassNoteDiesAwayAfterItsRelease) {
-  Synth synth;
-  std::vector<bool> notes(128, false);
-  notes[21] = true;
-  synth.prepare({loadPreset(HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml")},
-                {.sampleRate = kTakeRate, .maxBlock = 256, .notes = notes, .threads = 1});
-  const double release = 1.0;
-  long silentAt = -1;
-  testing::render(synth, {{0.0, on(21, 127)}, {release, off(21)}}, 8.0, 256, [&](long frames) {
-    if (silentAt < 0 && synth.silent()) silentAt = frames;
-  });
-  ASSERT_GT(silentAt, 0) << "still sounding 7 s after the release";
-  std::printf("silent %.2f s after the release\n",
-              static_cast<double>(silentAt) / kTakeRate - release);
+  EXPECT_GT(silentAfterRelease(21, 127, 8.0), 0.0) << "still sounding 7 s after the release";
 }
 
 // CC120 (all sound off) silences the body with the voices: a pedalled chord rings on the board
