@@ -85,12 +85,12 @@ class HamiltonePlugin : public Plugin {
   void setParameterValue(uint32_t index, float value) override {
     if (index >= kStatus) return;
     values_[index].store(value, std::memory_order_relaxed);
-    // An index out of range is refused by the loader, naming it: held within ±1e9 so that it
-    // reaches the loader as sent rather than wrapped (1e10 was logged as preset 1410065408).
+    // An index out of range is refused by the loader, naming it: held within ±1e9 before it is
+    // rounded, so that it reaches the loader with its sign and near what was sent (lround of
+    // 1e10 wraps where long has 32 bits; of ±inf it is unspecified).
     if (index == kPreset)
-      loader_.setBundled(std::isnan(value) ? -1
-                                           : static_cast<int>(std::clamp(
-                                                 std::lround(value), -1000000000L, 1000000000L)));
+      loader_.setBundled(
+          std::isnan(value) ? -1 : static_cast<int>(std::lround(std::clamp(value, -1e9f, 1e9f))));
   }
 
   // Not the audio thread (DPF calls it from the host's main or worker thread).

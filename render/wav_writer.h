@@ -17,7 +17,7 @@ enum class SampleFormat { pcm16, pcm24, float32 };  // Ogg Vorbis, lossy, has no
 
 enum class FileType { wav, flac, ogg };
 
-constexpr int kOggMaxRate = 200000;  // Hz: the highest libsndfile's Vorbis encoder takes
+constexpr int kOggMaxRate = 200000;  // Hz: the highest libvorbis's encoder setup takes
 
 // The type the extension of `path` names, in any case: .wav, .flac, .ogg. UsageError naming `flag`,
 // the path and its extension, and listing the valid ones, for any other extension or none.

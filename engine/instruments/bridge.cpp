@@ -40,6 +40,9 @@ void Bridge::prepare(const BridgePhysics& p, double k, double addedStiffness) {
           p.resistance, "a finite number >= 0 kg/s");
   require(p.angle >= 0.0 && p.angle <= kMaxBridgeAngle, "bridge_angle_deg",
           p.angle * 180.0 / std::numbers::pi, "between 0 and 10 degrees");
+  require(p.angle == 0.0 || p.resistance > 0.0, "bridge_resistance_kg_s", p.resistance,
+          "> 0 kg/s where bridge_angle_deg > 0: only the resistance ends the motion the strings' "
+          "tension drives (bridge.h)");
   // Störmer–Verlet's bound on the bridge's own row, the strings' K_s included.
   const double stiffest = p.stiffness + addedStiffness;
   require(k * k * stiffest / p.mass < 4.0, "bridge_mass_kg", p.mass,
@@ -70,8 +73,10 @@ double Bridge::advance(double& before, double& now, double force) noexcept {
 
 double Bridge::step(double force, double drive) noexcept {
   advance(w0_, w1_, force);
-  const double velocity = advance(d0_, d1_, drive);
-  supplied_ += drive * k_ * velocity;  // D^n (w_D^{n+1} − w_D^{n−1})/2
+  if (drive != 0.0 || d0_ != 0.0 || d1_ != 0.0) {  // a level bridge's w_D stays 0: not stepped
+    const double velocity = advance(d0_, d1_, drive);
+    supplied_ += drive * k_ * velocity;  // D^n (w_D^{n+1} − w_D^{n−1})/2
+  }
   return w1_;
 }
 

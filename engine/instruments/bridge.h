@@ -71,16 +71,21 @@ class BridgeCoupling {
 // EA sin²α / L, 40 to 400 N/m a string at 1° from bass to treble, against the bridges' 1e5 to
 // 7e5) — its work tallied in supplied().
 // The equation being linear, w = w_F + w_D, each part the response to F or D alone, and each
-// keeps its own balance above. The strings' ends follow w_F only, the board takes both: the motion
-// D drives is passed on, not back. Letting the strings feel w_D too — half of D's reaction without
-// the other half — closed a loop that is not passive (tension change → w_D → the strings' ends →
-// their tension change): A0 at velocity 127 on grand-piano then rang at −65 dBFS for good after
-// its release, a steady longitudinal mode (465.75 Hz and its harmonics), at 0.5° as at 1°.
-// Levels as the scheme's: after a step it holds w^n and w^{n+1}; the strings' next step takes
-// w_F^{n+1}, current(), and so does the force of the bridge's next step.
+// keeps its own balance above: energy() is H(w_F) + H(w_D) and dissipated() sums R_b k (δt· w)²
+// of each part (the cross terms of H(w_F + w_D) dropped), so the strings, both parts and E_c
+// balance exactly with supplied(). The strings' ends follow w_F only (E_c), the board takes both:
+// the motion D drives is passed on, not back. D is one-way; letting the motion it drives reach
+// the strings through E_c closed a loop with a one-way link, which is not passive (tension change
+// → w_D → the strings' ends → their tension change): A0 at velocity 127 on grand-piano then rang
+// at −65 dBFS for good after its release, a steady longitudinal mode (465.75 Hz and its
+// harmonics), at 0.5° as at 1°. With w_D on its own, only R_b takes its energy: an angle needs a
+// resistance (prepare()).
+// Levels as the scheme's: after a step it holds both parts at levels n and n + 1; the strings'
+// next step takes w_F^{n+1}, current(), and so does the force of the bridge's next step.
 class Bridge {
  public:
   // Throws std::invalid_argument naming the field if a value is not finite and >= 0 (mass > 0),
+  // an angle > 0 on a bridge without resistance (the motion the drive gives it would never end),
   // or if k² (K_b + `addedStiffness`) / M_b >= 4 — the strings' K_s summed: the explicit coupling
   // would not be stable.
   void prepare(const BridgePhysics& physics, double k, double addedStiffness);

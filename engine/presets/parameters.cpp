@@ -196,7 +196,8 @@ constexpr Parameter kTable[] = {
      .doc = "Angle of the speaking length to the board where it crosses the bridge (its share of "
             "the downbearing, docs/instrument-data.md §3.7): the strings' tension change pushes "
             "the bridge by sin(angle) of it, bringing their longitudinal end force — the phantom "
-            "partials and longitudinal modes — to the board. 0: the transverse end force alone."},
+            "partials and longitudinal modes — to the board. 0: the transverse end force alone. "
+            "Above 0 it needs bridge.resistance_kg_s > 0."},
 
     {.name = "body.enabled",
      .type = boolean,

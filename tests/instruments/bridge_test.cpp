@@ -320,6 +320,13 @@ TEST(Bridge, RefusesAMassTooLightForTheExplicitCoupling) {
                std::invalid_argument);
   EXPECT_THROW(b.prepare({.mass = 1.0, .stiffness = 0.0, .resistance = NAN}, kStep, 0.0),
                std::invalid_argument);
+  // An angle drives a motion only the resistance ends (bridge.h: w_D reaches no string).
+  try {
+    b.prepare({.mass = 1.0, .stiffness = 1e5, .resistance = 0.0, .angle = 0.01}, kStep, 0.0);
+    FAIL() << "a tilted bridge without resistance was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("bridge_resistance_kg_s"), std::string::npos) << e.what();
+  }
   for (double angle : {-0.01, 0.2, double(NAN)}) {  // rad; 0.2 rad is 11.5°, past the 10° allowed
     try {
       b.prepare({.mass = 1.0, .stiffness = 0.0, .resistance = 1.0, .angle = angle}, kStep, 0.0);
