@@ -43,9 +43,9 @@ long parseInteger(const std::string& flag, const std::string& text, long minimum
   char* end = nullptr;
   errno = 0;
   const long x = std::strtol(text.c_str(), &end, 10);
-  if (text.empty() || end != text.c_str() + text.size() || errno == ERANGE)
+  if (text.empty() || end != text.c_str() + text.size())
     throw UsageError(flag + " = '" + text + "': not a whole number; " + valid);
-  if (x < minimum || x > maximum)
+  if (errno == ERANGE || x < minimum || x > maximum)  // ERANGE: a whole number past long's range
     throw UsageError(flag + " = " + text + ": out of range; " + valid);
   return x;
 }

@@ -138,8 +138,8 @@ CLI::App* addWaveCommand(CLI::App& app, WaveArguments& a) {
       "  ⅛[p]ᵀM⁻¹[p] <= eps_fly H̃^{n+1} is discarded and redone from the same state with half\n"
       "  the step (H̃ is conserved for any step sequence, Theorem 1, so nothing is lost). After\n"
       "  4 accepted steps in a row with the gap <= eps_fly H̃ / 4 the step doubles, at most to\n"
-      "  --k. A step below --min-step ends the run with exit code 1 and no file. The run stops\n"
-      "  at the last step at or before --duration.\n"
+      "  --k. A step below --min-step ends the run with exit code 2 (the parameters cannot run)\n"
+      "  and no file. The run stops at the last step at or before --duration.\n"
       "Summary: 'name: value' lines: steps, rejected steps, force evaluations, the start's\n"
       "  pseudo-energy, its max relative and absolute drift, the min and max step, and with\n"
       "  --adaptive the max of gap / (eps_fly H̃).\n" +
@@ -260,10 +260,10 @@ int runWaveCommand(const WaveArguments& a) {
         a.adaptive ? t + scheme.nextStep() > duration + slack : scheme.stepIndex() == steps;
     if (done) break;
     if (!scheme.step())
-      throw std::runtime_error("--adaptive: at t = " + formatNumber(t) +
-                               " s the bound ⅛[p]ᵀM⁻¹[p] <= eps_fly H̃ " +
-                               "needs a step below --min-step = " + formatNumber(adaptive.minStep) +
-                               " s; no file written. Raise --eps-fly or lower --min-step");
+      throw UsageError("--adaptive: at t = " + formatNumber(t) +
+                       " s the bound ⅛[p]ᵀM⁻¹[p] <= eps_fly H̃ " +
+                       "needs a step below --min-step = " + formatNumber(adaptive.minStep) +
+                       " s; no file written. Raise --eps-fly or lower --min-step");
   }
   if (shapes)
     for (; nextSnapshot < snapshots.size(); ++nextSnapshot) writeShape(scheme, shapes->stream());

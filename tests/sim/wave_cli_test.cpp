@@ -101,9 +101,12 @@ TEST_F(WaveCli, AdaptiveRunReportsItsStepsAndTheGapBound) {
   for (const auto& row : rows) EXPECT_LE(row[4], 3e-4 * row[2] * (1 + 1e-9));
 }
 
+// Parameters that cannot run are bad input (exit 2, as failure-behaviour.md's table says), not an
+// I/O error (1), even when found after the start; the message names the subcommand.
 TEST_F(WaveCli, AStepBelowTheMinimumEndsTheRunWithAnError) {
   const CliResult r = run("--adaptive --eps-fly 1e-12 --min-step 0.001 --out " + path("run.csv"));
-  EXPECT_EQ(r.exitCode, 1);
+  EXPECT_EQ(r.exitCode, 2);
+  EXPECT_NE(r.err.find("hamiltone-sim wave:"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("--min-step"), std::string::npos) << r.err;
   EXPECT_TRUE(fs::is_empty(dir_));
 }
