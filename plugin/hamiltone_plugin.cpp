@@ -1,5 +1,7 @@
 // The DPF plugin: parameters and state in, PlayingSynth on the audio thread, SynthLoader building
 // away from it. DPF makes the LV2, CLAP and VST3 plugins of this one class.
+#include <pthread.h>
+
 #include <atomic>
 #include <cmath>
 #include <span>
@@ -111,8 +113,15 @@ class HamiltonePlugin : public Plugin {
     loader_.stop();
   }
 
+  // A host may cancel its audio thread — JACK2's jack_client_close does, asynchronously, when a
+  // process call is slow to return (jalv quitting under load) — and that cancellation's unwinding
+  // cannot cross the engine's noexcept frames: std::terminate (jalv aborted 4 times of 4). So it
+  // waits while the synthesizer renders and acts, if one came, where run() enables it again: a
+  // frame it may unwind through. Setting the state is a flag in the thread's own data.
   void run(const float**, float** outputs, uint32_t frames, const MidiEvent* midiEvents,
            uint32_t midiEventCount) override {
+    int cancellation = PTHREAD_CANCEL_ENABLE;
+    ::pthread_setcancelstate(PTHREAD_CANCEL_DISABLE, &cancellation);
     const auto value = [this](unsigned i) { return values_[i].load(std::memory_order_relaxed); };
     playing_.setControls(
         {.gainDb = value(kGainDb),
@@ -121,6 +130,7 @@ class HamiltonePlugin : public Plugin {
          .polyphony = static_cast<int>(std::lround(kPolyphonyRange.held(value(kPolyphony))))});
     playing_.process(std::span(outputs[0], frames), std::span(outputs[1], frames),
                      std::span(midiEvents, midiEventCount));
+    ::pthread_setcancelstate(cancellation, nullptr);
   }
 
  private:

@@ -127,7 +127,7 @@ class ClapInstance {
 
   // One process call: writes left.size() frames; `events` sorted by frame, each inside the block.
   clap_process_status process(std::span<float> left, std::span<float> right,
-                              std::span<const ClapEvent> events) noexcept {
+                              std::span<const ClapEvent> events) {
     float* channels[2] = {left.data(), right.data()};
     clap_audio_buffer_t out{channels, nullptr, 2, 0, 0};
     EventList list{events};
