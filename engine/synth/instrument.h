@@ -49,5 +49,8 @@ struct Instrument {
 // with the instrument's bend range, and sharing one hammer — M_H/n and K_H/n each, the same hammer
 // while the strings move alike (F = K δ^p). The loader checks these very patches.
 StringPatch unisonPatch(const Instrument& instrument, int note, int string);
+// How far the key's bridge pulls its strings' fundamental at `hz`, cents (negative: flat), struck
+// together (in phase); 0 without a bridge.
+double bridgeLoadCents(const StringKey& key, double hz);
 
 }  // namespace hamiltone
