@@ -41,8 +41,8 @@ void Bridge::prepare(const BridgePhysics& p, double k, double addedStiffness) {
   require(p.angle >= 0.0 && p.angle <= kMaxBridgeAngle, "bridge_angle_deg",
           p.angle * 180.0 / std::numbers::pi, "between 0 and 10 degrees");
   require(p.angle == 0.0 || p.resistance > 0.0, "bridge_resistance_kg_s", p.resistance,
-          "> 0 kg/s where bridge_angle_deg > 0: only the resistance ends the motion the strings' "
-          "tension drives (bridge.h)");
+          "> 0 kg/s where the bridge's angle is above 0: only the resistance ends the motion the "
+          "strings' tension drives (bridge.h)");
   // Störmer–Verlet's bound on the bridge's own row, the strings' K_s included.
   const double stiffest = p.stiffness + addedStiffness;
   require(k * k * stiffest / p.mass < 4.0, "bridge_mass_kg", p.mass,
