@@ -94,7 +94,7 @@ std::string limiterSummary(long limitedFrames, long overFrames, double deepestRe
   char text[200];
   const double peakDb = peakIn > 0.0 ? 20.0 * std::log10(peakIn) : -INFINITY;
   const double ceilingDb = 20.0 * std::log10(ceiling);
-  if (limitedFrames == 0 && !(peakIn > 0.0))
+  if (outputSilent(limitedFrames, peakIn))
     return "the output is silent: every sample is 0 (the limiter did not act)";
   if (limitedFrames == 0) {
     std::snprintf(text, sizeof text,

@@ -42,6 +42,12 @@ std::string renderSummary(double renderedSeconds, double wallSeconds);
 // stolen at the limit of 64 voices". `loudestLevel` is Synth::loudestSteal() (1 is the peak).
 std::string stealSummary(long steals, double loudestLevel, int limit);
 
+// Whether a render's output is all zeros: the limiter never acted and nothing before it was above
+// 0.
+inline bool outputSilent(long limitedFrames, double peakIn) {
+  return limitedFrames == 0 && !(peakIn > 0.0);
+}
+
 // What the master's limiter (PeakLimiter) did to a render: "peak -2.4 dBFS before the limiter,
 // 2.2 dB under its ceiling of -0.18 dBFS: it did not act", or "the limiter reduced the gain by
 // up to 3.1 dB on 5120 frames (0.107 s; 12 over its ceiling of -0.18 dBFS); peak before it

@@ -145,7 +145,7 @@ int run(const RenderArguments& a) {
                  limiterSummary(stats.limitedFrames, stats.overFrames, stats.limiterDeepestDb,
                                 stats.peakBeforeLimiter, MasterBus::kCeiling, rate)
                      .c_str());
-  } else if (stats.limitedFrames == 0 && !(stats.peakBeforeLimiter > 0.0)) {
+  } else if (outputSilent(stats.limitedFrames, stats.peakBeforeLimiter)) {
     std::fprintf(stderr, "hamiltone-render: warning: %s: the output is silent: every sample is 0\n",
                  a.out.c_str());
   }

@@ -204,11 +204,10 @@ void WavWriter::commit() {
     // Cut what a failed write left past the last whole frame: seeking the write position to
     // that frame puts the descriptor at the end of the data that is kept. libsndfile computes
     // the header's sizes from the file's length on close.
-    const int fd = fileno(file_.stream());
     const off_t end = sf_seek(sound_, static_cast<sf_count_t>(written_), SEEK_SET) < 0
                           ? -1
-                          : ::lseek(fd, 0, SEEK_CUR);
-    if (end < 0 || ::ftruncate(fd, end) != 0)
+                          : ::lseek(descriptor_, 0, SEEK_CUR);
+    if (end < 0 || ::ftruncate(descriptor_, end) != 0)
       throw std::runtime_error("writing " + path_ + " failed: cannot cut it to the " +
                                std::to_string(written_) + " frames written");
     ioError_ = 0;  // the data's failure is handled: what follows is the header's
