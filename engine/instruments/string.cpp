@@ -106,19 +106,38 @@ double NonlinearString::stiffnessEigenvalueMax() const {
   return transverseEigenvalue(segments_ - 1, tensionScaleMax_);
 }
 
+void NonlinearString::setLossWeights(const LossWeights& w) {
+  for (const double x : {w.transverse, w.longitudinalConstant, w.longitudinal})
+    if (!(std::isfinite(x) && x >= 0.0))
+      throw std::invalid_argument("loss weight " + formatNumber(x) +
+                                  ": must be a finite number >= 0 (C = M(−Λ) must stay >= 0)");
+  lossWeights_ = w;
+}
+
 double NonlinearString::lossOperatorEigenvalueMax() const {
-  const double s = std::sin((segments_ - 1) * std::numbers::pi / (2.0 * segments_));
-  return 4.0 / (h_ * h_) * s * s;
+  // The blocks are apart, so the largest is the larger block's: −D2's top eigenvalue on each grid.
+  auto top = [](int m, double h) {
+    const double s = std::sin((m - 1) * std::numbers::pi / (2.0 * m));
+    return 4.0 / (h * h) * s * s;
+  };
+  const double u = lossWeights_.transverse * top(segments_, h_);
+  if (grid_.longitudinal < 2) return u;
+  return std::max(u, lossWeights_.longitudinalConstant +
+                         lossWeights_.longitudinal * top(grid_.longitudinal, hv_));
 }
 
 void NonlinearString::applyLossOperator(const Vector& a, const Vector& b, Vector& out) const {
   const Eigen::Index nu = segments_ - 1, nv = grid_.longitudinal - 1;
-  // M (−D2) = −ρA h D2 on each grid, with its own h.
+  // M (−Λ) = −ρA h w D2 on each grid with its own h and weight, and ρA h_v w_v0 I on v.
   const double rhoA = physics_.linearDensity();
-  kernels_->secondDifferenceOfDifference(a.data(), b.data(), out.data(), nu, -rhoA / h_);
-  if (nv > 0)
-    kernels_->secondDifferenceOfDifference(a.data() + nu, b.data() + nu, out.data() + nu, nv,
-                                           -rhoA / hv_);
+  kernels_->secondDifferenceOfDifference(a.data(), b.data(), out.data(), nu,
+                                         -rhoA * lossWeights_.transverse / h_);
+  if (nv == 0) return;
+  kernels_->secondDifferenceOfDifference(a.data() + nu, b.data() + nu, out.data() + nu, nv,
+                                         -rhoA * lossWeights_.longitudinal / hv_);
+  if (lossWeights_.longitudinalConstant > 0.0)
+    out.segment(nu, nv) +=
+        (rhoA * hv_ * lossWeights_.longitudinalConstant) * (a.segment(nu, nv) - b.segment(nu, nv));
 }
 
 namespace {

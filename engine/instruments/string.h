@@ -67,10 +67,22 @@ class NonlinearString {
   // η_M the last coarse strain. On a string stretched uniformly by ε it is EA ε (Hooke).
   double endTension() const { return endTension_; }
 
-  // M(−L)(a − b), L = D2 on u and on v: the operator of the frequency-dependent loss σ1. `out`
-  // must not be `a` or `b`.
+  // C(a − b), C = M(−Λ) the operator of the frequency-dependent loss σ1 (linear_loss.h), with
+  //   −Λ = w_u (−D2) on u,   w_v0 I + w_v1 (−D2) on v,
+  // so that the scheme's σ1 damps a mode of wavenumber² ξ at σ1 w_u ξ on u and σ1 (w_v0 + w_v1 ξ)
+  // on v: each wave may have its own law. The paper's (49) has one, w = (1, 0, 1), the default.
+  // `out` must not be `a` or `b`.
+  struct LossWeights {
+    double transverse = 1.0;            // w_u
+    double longitudinalConstant = 0.0;  // w_v0, 1/m²
+    double longitudinal = 1.0;          // w_v1
+  };
+  // Throws std::invalid_argument if a weight is negative or not finite.
+  void setLossWeights(const LossWeights& weights);
+  const LossWeights& lossWeights() const { return lossWeights_; }
   void applyLossOperator(const Vector& a, const Vector& b, Vector& out) const;
-  double lossOperatorEigenvalueMax() const;  // λmax(−D2) < 4/h²
+  // λmax(M⁻¹C): the larger of w_u (4/h²) sin²((Mu−1)π/2Mu) and w_v0 + w_v1 (4/h_v²) sin²(…) on v.
+  double lossOperatorEigenvalueMax() const;
 
   // Pitch bend: the transverse wave sees the tension β·T0 (the longitudinal wave and V' keep T0,
   // as a tuning peg's small stretch leaves EA − T0 unchanged). stiffnessEigenvalueMax() answers for
@@ -100,6 +112,7 @@ class NonlinearString {
   double h_, hv_;         // h_u, h_v
   Vector inverseMass_;
   double tensionScale_ = 1.0, tensionScaleMax_ = 1.0;
+  LossWeights lossWeights_;
   mutable double endTension_ = 0.0;
   // Work of the stencils and the gradient: per fine segment (size Mu; work3_ holds u padded with
   // its fixed ends, Mu + 1, then zeros; work1_ and scratch_ the two-grid kernels', Mu + kMaxLanes

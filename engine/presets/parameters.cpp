@@ -431,6 +431,26 @@ constexpr Parameter kTable[] = {
      .defaultText = "2000",
      .model = kString,
      .doc = "Frequency at which t60_high_s holds."},
+    {.name = "loss.longitudinal_t60_low_s",
+     .unit = "s",
+     .min = 0.01,
+     .max = kInf,
+     .defaultText = "shared",
+     .defaultKind = kDerived,
+     .model = kString,
+     .doc = "The longitudinal wave's own decay time at 0 Hz; unset, it shares the transverse law "
+            "by wavenumber (BDZ (49)), which leaves its modes nearly lossless. Set, its law is "
+            "fitted by frequency (σ0 + σ1 ω²ρ/E), at least the transverse σ0. Set alone, "
+            "longitudinal_t60_high_s takes its value."},
+    {.name = "loss.longitudinal_t60_high_s",
+     .unit = "s",
+     .min = 0.01,
+     .max = kInf,
+     .defaultText = "shared",
+     .defaultKind = kDerived,
+     .model = kString,
+     .doc = "The longitudinal wave's decay time at t60_high_Hz; at most longitudinal_t60_low_s. "
+            "Set alone, longitudinal_t60_low_s takes its value."},
     {.name = "loss.damper_t60_s",
      .unit = "s",
      .min = 0.01,

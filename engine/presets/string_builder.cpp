@@ -34,6 +34,8 @@ constexpr VoiceField kStringFields[] = {
     {"t60_low_s", "loss.t60_low_s"},
     {"t60_high_s", "loss.t60_high_s"},
     {"t60_high_hz", "loss.t60_high_Hz"},
+    {"longitudinal_t60_low_s", "loss.longitudinal_t60_low_s"},
+    {"longitudinal_t60_high_s", "loss.longitudinal_t60_high_s"},
     {"tension", "string.tension_N"},
     {"length", "string.length_m"},
     {"young", "string.young_Pa"},
@@ -71,6 +73,10 @@ void buildStringKeys(const PresetValues& values, Instrument& instrument) {
   common.oversampling = static_cast<int>(number("scheme.oversampling"));
   if (values.setting("scheme.epsilon_J")) common.epsilon = number("scheme.epsilon_J");
   common.t60HighHz = number("loss.t60_high_Hz");
+  if (values.setting("loss.longitudinal_t60_low_s"))
+    common.longitudinalT60Low = number("loss.longitudinal_t60_low_s");
+  if (values.setting("loss.longitudinal_t60_high_s"))
+    common.longitudinalT60High = number("loss.longitudinal_t60_high_s");
   common.pickups[0] = number("pickups.left_position");
   common.pickups[1] = number("pickups.right_position");
   common.channels = static_cast<int>(number("pickups.channels"));

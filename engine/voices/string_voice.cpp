@@ -147,6 +147,33 @@ StringLoss stringLossFromT60(const StringPhysics& string, double t60Low, double 
   return loss;
 }
 
+StringLoss withLongitudinalLoss(StringLoss loss, const StringPhysics& string, double t60Low,
+                                double t60High, double highHz) {
+  require(t60Low > 0.0, "longitudinal_t60_low_s", t60Low, "> 0 seconds (inf for no loss)");
+  require(t60High > 0.0 && t60High <= t60Low, "longitudinal_t60_high_s", t60High,
+          "> 0 and at most longitudinal_t60_low_s = " + formatNumber(t60Low) +
+              " (higher longitudinal modes decay faster)");
+  const double omega = 2.0 * std::numbers::pi * highHz;
+  loss.ownLongitudinal = true;
+  loss.longitudinalSigma0 = std::isfinite(t60Low) ? kLn1000 / t60Low : 0.0;
+  const double high = std::isfinite(t60High) ? kLn1000 / t60High : 0.0;
+  loss.longitudinalSigma1 =
+      (high - loss.longitudinalSigma0) / (omega * omega * string.density / string.young);
+  return loss;
+}
+
+SchemeLoss schemeLoss(const StringLoss& loss, const StringPhysics& string) {
+  if (!loss.ownLongitudinal) return {.sigma1 = loss.sigma1, .weights = {}};
+  const double excess = std::max(0.0, loss.longitudinalSigma0 - loss.sigma0);
+  const double firstMode = std::pow(string.length / std::numbers::pi, 2);  // 1 / (π/L)²
+  const double scale = std::max({loss.sigma1, loss.longitudinalSigma1, excess * firstMode});
+  if (scale == 0.0) return {.sigma1 = 0.0, .weights = {}};
+  return {.sigma1 = scale,
+          .weights = {.transverse = loss.sigma1 / scale,
+                      .longitudinalConstant = excess / scale,
+                      .longitudinal = loss.longitudinalSigma1 / scale}};
+}
+
 void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleRate) {
   const int r = patch.oversampling;
   require(r == 1 || r == 2 || r == 4 || r == 8 || r == 16 || r == 32 || r == 64, "oversampling", r,
@@ -200,6 +227,10 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
   StringLoss loss;
   for (int round = 0; round < 3; ++round) {
     loss = stringLossFromT60(tuned.physics, patch.t60Low, patch.t60High, patch.t60HighHz);
+    if (patch.longitudinalT60Low || patch.longitudinalT60High)
+      loss = withLongitudinalLoss(
+          loss, tuned.physics, patch.longitudinalT60Low.value_or(*patch.longitudinalT60High),
+          patch.longitudinalT60High.value_or(*patch.longitudinalT60Low), patch.t60HighHz);
     const bool two = patch.grid == GridRule::twoGrid;
     tuned = tuneString(patch.string, patch.tuneBy, patch.grid, k, loss.sigma1,
                        patch.gridFactor * (two ? 1.0 : std::sqrt(betaMax)), target,
@@ -223,12 +254,44 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
   const bool hasFelt = patch.feltDamper && patch.damperT60 < kNoDamperT60;
   const double epsilon = gaugeShift(patch, string, k);
   string.setTensionRange(betaMax);
+  // The grid was sized with u's σ1; v's own law must keep the bound (44) too, which a decay time
+  // of milliseconds breaks on v's top modes. The shortest stable one is found by bisection.
+  const SchemeLoss schemeSide = schemeLoss(loss, tuned.physics);
+  if (loss.ownLongitudinal) {
+    const double low = patch.longitudinalT60Low.value_or(*patch.longitudinalT60High);
+    const double high = patch.longitudinalT60High.value_or(low);
+    const StringLoss transverse =
+        stringLossFromT60(tuned.physics, patch.t60Low, patch.t60High, patch.t60HighHz);
+    auto stable = [&](double lowT60, double highT60) {
+      const SchemeLoss side = schemeLoss(
+          withLongitudinalLoss(transverse, tuned.physics, lowT60, highT60, patch.t60HighHz),
+          tuned.physics);
+      string.setLossWeights(side.weights);
+      return k <= maxStableStep(string.stiffnessEigenvalueMax(), string.lossOperatorEigenvalueMax(),
+                                side.sigma1);
+    };
+    require(stable(low, low), "longitudinal_t60_low_s", low,
+            "longer: v's modes would decay faster than the explicit loss is stable for at this "
+            "rate (the bound (44))");
+    if (!stable(low, high)) {
+      double shortest = low, unstable = high;  // stable(low, shortest), not stable(low, unstable)
+      for (int i = 0; i < 60; ++i) {
+        const double mid = std::sqrt(shortest * unstable);
+        (stable(low, mid) ? shortest : unstable) = mid;
+      }
+      require(false, "longitudinal_t60_high_s", high,
+              "at least " + formatApprox(shortest, 3) +
+                  " s at this rate: shorter, v's highest modes would decay faster than the "
+                  "explicit loss is stable for (the bound (44))");
+    }
+  }
+  string.setLossWeights(schemeSide.weights);
   const HammeredString system(std::move(string), patch.hammer);
   InitialState rest{Vector::Zero(system.size()), Vector::Zero(system.size())};
   rest.q[system.hammerIndex()] = kParkedAt;
   const StepParameters params{.k = k,
                               .sigma0 = loss.sigma0,
-                              .sigma1 = loss.sigma1,
+                              .sigma1 = schemeSide.sigma1,
                               .epsilon = epsilon,
                               .trackDissipation = false};
   auto scheme = std::make_unique<SplitSav<HammeredString>>(system, params, rest);

@@ -34,6 +34,9 @@ struct StringPatch {
   double t60Low = 20.0;  // s, decay time at 0 Hz (infinite: no loss)
   double t60High = 4.0;  // s, decay time at t60HighHz
   double t60HighHz = 2000.0;
+  // The longitudinal wave's own decay times at 0 Hz and at t60HighHz (StringLoss); none: v shares
+  // the transverse law by wavenumber, as in the paper's (49). One alone: both take its value.
+  std::optional<double> longitudinalT60Low, longitudinalT60High;
   double damperT60 = 0.25;  // s, the fundamental's T60 added once released (the felt's share)
   // false: the damper adds ln(1000)/damperT60 to σ0, every partial alike (releasedSigma0); true:
   // its felt, from damperPosition·L and damperWidth long, damps each by its shape there (D2).
@@ -61,13 +64,29 @@ double strikeEnergyScale(const StringPatch& patch);
 
 // σ(ξ) = σ0 + σ1 ξ is the decay rate of a mode of wavenumber² ξ; two T60s fix it
 // (docs/instrument-data.md §3.4): σ0 = 6.908 / T60(0 Hz), σ1 = (6.908 / T60(f) − σ0) / ξ(f), ξ(ω)
-// from c²ξ + κ²ξ² = ω².
+// from c²ξ + κ²ξ² = ω². The longitudinal wave may have its own pair, fitted alike with its own ξ(ω)
+// = ω² ρ/E (v's linear stiffness is EA: K's T0 and V''s EA − T0), so that at a given frequency
+// the law is the same function of ω as RT-425's σ = R + η ω² (docs/instrument-data.md §3.1).
 struct StringLoss {
   double sigma0 = 0.0;
   double sigma1 = 0.0;
+  bool ownLongitudinal = false;  // false: v takes σ0 and σ1 too (BDZ (49))
+  double longitudinalSigma0 = 0.0, longitudinalSigma1 = 0.0;
 };
 StringLoss stringLossFromT60(const StringPhysics& string, double t60Low, double t60High,
                              double highHz);
+// `loss` with v's own law from its two T60s (field names longitudinal_t60_low_s / _high_s).
+StringLoss withLongitudinalLoss(StringLoss loss, const StringPhysics& string, double t60Low,
+                                double t60High, double highHz);
+// The scheme's σ1 and the string's loss weights (NonlinearString::LossWeights) that give u and v
+// their laws. The scheme's σ0 is common to both waves, so v decays at least at the transverse σ0:
+// its weight w_v0 carries max(0, σ0_v − σ0) / σ1. σ1 is the largest of σ1_u, σ1_v and that excess
+// at the first mode's wavenumber² (π/L)², so no weight exceeds 1.
+struct SchemeLoss {
+  double sigma1 = 0.0;
+  NonlinearString::LossWeights weights;
+};
+SchemeLoss schemeLoss(const StringLoss& loss, const StringPhysics& string);
 
 class StringVoice {
  public:

@@ -199,6 +199,42 @@ TEST(NonlinearString, LossOperatorIsMinusRhoAhD2OfTheDifference) {
   }
 }
 
+// Each wave its own law: with weights (w_u, w_v0, w_v1), M⁻¹C is w_u (−D2) on u and w_v0 + w_v1
+// (−D2) on v, so its eigenvalues are those of the two blocks, and the bound reports the larger top.
+TEST(NonlinearString, WeightedLossOperatorGivesEachWaveItsLaw) {
+  const StringGrid grid{12, 4};
+  for (const NonlinearString::LossWeights w :
+       {NonlinearString::LossWeights{0.25, 3.0, 2.0}, NonlinearString::LossWeights{1.0, 0.0, 40.0},
+        NonlinearString::LossWeights{0.0, 5.0, 0.0}}) {
+    NonlinearString string(c3(), grid);
+    string.setLossWeights(w);
+    const Eigen::Index n = string.size();
+    const Eigen::MatrixXd c = matrixOf(string, [&](const Vector& x, Vector& y) {
+      string.applyLossOperator(x, Vector::Zero(n), y);
+    });
+    const Vector root = string.inverseMass().cwiseSqrt();
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(root.asDiagonal() * c * root.asDiagonal());
+    std::vector<double> expected;
+    auto minusD2 = [](int m, int segments, double h) {
+      return 4.0 / (h * h) * std::pow(std::sin(m * std::numbers::pi / (2.0 * segments)), 2);
+    };
+    for (int m = 1; m < grid.transverse; ++m)
+      expected.push_back(w.transverse * minusD2(m, grid.transverse, string.spacing()));
+    for (int m = 1; m < grid.longitudinal; ++m)
+      expected.push_back(w.longitudinalConstant +
+                         w.longitudinal *
+                             minusD2(m, grid.longitudinal, string.longitudinalSpacing()));
+    std::sort(expected.begin(), expected.end());
+    const double top = expected.back();
+    for (size_t i = 0; i < expected.size(); ++i)
+      EXPECT_NEAR(eig.eigenvalues()[static_cast<Eigen::Index>(i)], expected[i], 1e-9 * top);
+    EXPECT_NEAR(string.lossOperatorEigenvalueMax(), top, 1e-9 * top);
+  }
+  NonlinearString string(c3(), grid);
+  for (const double bad : {-1.0, static_cast<double>(NAN), static_cast<double>(INFINITY)})
+    EXPECT_THROW(string.setLossWeights({1.0, bad, 1.0}), std::invalid_argument) << bad;
+}
+
 // The paper's first-mode start (70) at α = 300 and the extreme α = 1000 (u = 0.94 m on a 1.26 m
 // string), on the transverse grid at 48 kHz where the longitudinal wave is far from resolved:
 // (38) keeps its energy (41) for 2 s and the state finite. Roundoff: ~1e5 steps.

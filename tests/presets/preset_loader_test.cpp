@@ -351,6 +351,29 @@ TEST(PresetLoader, DefaultsAreTheVoicesDefaults) {
   EXPECT_EQ(plate.guardEnergyMultiple, wantPlate.guardEnergyMultiple);
 }
 
+// The longitudinal wave's own law: the bundled pianos carry RT-425's (data §3.1), the paper's C3
+// shares the transverse law (unset); set alone, one time stands for both; a law that is no decay
+// is refused at its line, naming what would be valid.
+TEST(PresetLoader, TheLongitudinalLossLawIsReadAndChecked) {
+  for (const char* name : {"presets/grand-piano.toml", "presets/grand-piano-strings.toml"}) {
+    const Instrument piano = loadPreset(sourcePath(name));
+    EXPECT_EQ(piano.keys.front().patch.longitudinalT60Low, 13.8) << name;
+    EXPECT_EQ(piano.keys.back().patch.longitudinalT60High, 6.10) << name;
+  }
+  const Instrument paper = loadPreset(sourcePath("presets/paper-c3-string.toml"));
+  EXPECT_FALSE(paper.keys.front().patch.longitudinalT60Low);
+  EXPECT_FALSE(paper.keys.front().patch.longitudinalT60High);
+  const Instrument alone =
+      parsePreset(kStringHead + "[loss]\nlongitudinal_t60_low_s = 9\n", "test.toml");
+  EXPECT_EQ(alone.keys.front().patch.longitudinalT60Low, 9.0);
+  EXPECT_FALSE(alone.keys.front().patch.longitudinalT60High);
+  EXPECT_THAT(
+      errorsOfText(kStringHead +
+                   "[loss]\nlongitudinal_t60_low_s = 2\nlongitudinal_t60_high_s = 3\n"),
+      ElementsAre("test.toml:6:1: loss.longitudinal_t60_high_s = 3 at C2: must be > 0 and at most "
+                  "longitudinal_t60_low_s = 2 (higher longitudinal modes decay faster)"));
+}
+
 TEST(PresetLoader, VoiceCheckCanBeLeftOut) {
   const std::string path = sourcePath("tests/data/presets/bad-unstable.toml");
   EXPECT_FALSE(errorsOf(path).empty());

@@ -382,6 +382,81 @@ TEST(StringVoice, KeyboardExtremesStayFiniteAndConserveEnergy) {
   }
 }
 
+// The longitudinal wave's own law (docs/instrument-data.md §3.1: RT-425's R_v = 0.5 1/s and η_v =
+// 1e-9 s, as T60s of 13.8 s at 0 Hz and 6.10 s at 4 kHz). C3's string on the two grids at 48 kHz,
+// v started in its mode m alone (u = 0 stays 0): the mode's amplitude decays at σ = R_v + η_v ω_m²,
+// ω_m² = (E/ρ) ξ_m with ξ_m v's discrete wavenumber² — the scheme's σ0 (the transverse 0.345 1/s)
+// plus what the string's weights add (schemeLoss). Measured as the mean square of the mode's
+// coordinate over 0.05 s (100 periods of mode 1) at the start and 0.45 s later: the explicit
+// loss's factor per step is 1 − (σ0 + σ')k + O(k²), and the windows' phase leaves under 0.5 %
+// (Störmer–Verlet measures the same). ε ≫ the mode's energy keeps the quadratised V′ linear, as
+// the voice's ε does a strike's (with ε = 0 a lone quadratic V′ hitting zero twice a period is
+// not a linear mode). Sharing the transverse law by wavenumber (BDZ (49)) leaves the mode at
+// σ0 + σ1_u ξ_m, within 5 % of σ0 alone: nearly lossless where σ0 is 0 (the bass).
+TEST(StringVoice, LongitudinalModesDecayByTheirOwnLaw) {
+  const double k = 1.0 / 48000.0, rv = 0.5, etaV = 1e-9;
+  const StringPhysics p = pianoString(48);
+  const StringLoss shared = stringLossFromT60(p, 20.0, 4.0, 4000.0);
+  const StringLoss own = withLongitudinalLoss(shared, p, 13.8, 6.10, 4000.0);
+  EXPECT_NEAR(own.longitudinalSigma0, rv, 1e-3);
+  const double omega4k = 2.0 * std::numbers::pi * 4000.0;
+  EXPECT_NEAR(own.longitudinalSigma1 * omega4k * omega4k * p.density / p.young,
+              etaV * omega4k * omega4k, 2e-3);  // 6.10 s rounds 6.1043 s
+  const StringGrid grid = stringGrid(p, GridRule::twoGrid, k, shared.sigma1, 1.0, 1.5);
+  const long window = 2400, steps = 24000;
+  for (const bool ownLaw : {true, false}) {
+    for (const int m : {1, 3}) {
+      const SchemeLoss side = schemeLoss(ownLaw ? own : shared, p);
+      NonlinearString string(p, grid);
+      string.setLossWeights(side.weights);
+      const double hv = string.longitudinalSpacing();
+      const double xi =
+          4.0 / (hv * hv) * std::pow(std::sin(m * std::numbers::pi / (2.0 * grid.longitudinal)), 2);
+      Vector shape(grid.longitudinal - 1);
+      for (int j = 1; j < grid.longitudinal; ++j)
+        shape[j - 1] = std::sin(m * std::numbers::pi * j / grid.longitudinal);
+      InitialState start{Vector::Zero(string.size()), Vector::Zero(string.size())};
+      start.q.tail(shape.size()) = 1e-10 * shape;
+      SplitSav<NonlinearString> scheme(
+          string, {.k = k, .sigma0 = shared.sigma0, .sigma1 = side.sigma1, .epsilon = 1e-6}, start);
+      double first = 0.0, last = 0.0;
+      for (long n = 0; n < steps; ++n) {
+        const double a = scheme.q().tail(shape.size()).dot(shape);
+        (n < window ? first : last) += n < window || n >= steps - window ? a * a : 0.0;
+        scheme.step();
+      }
+      const double sigma = std::log(first / last) / (2.0 * (steps - window) * k);
+      const double expected =
+          ownLaw ? rv + etaV * (p.young / p.density) * xi : shared.sigma0 + shared.sigma1 * xi;
+      EXPECT_NEAR(sigma, expected, 0.01 * expected) << (ownLaw ? "own" : "shared") << " m " << m;
+      if (!ownLaw) {
+        EXPECT_LT(sigma, 1.05 * shared.sigma0);
+      }
+    }
+  }
+}
+
+// The longitudinal law is refused, naming its field, where it is not a decay (high above low) and
+// where its top modes would decay faster than the explicit loss is stable for; set alone, each
+// time stands for both.
+TEST(StringVoice, RefusesALongitudinalLawItCannotPlay) {
+  StringPatch patch = piano(48);
+  patch.longitudinalT60Low = 2.0;
+  patch.longitudinalT60High = 3.0;
+  EXPECT_EQ(refusalOf(patch, 48).rfind("longitudinal_t60_high_s = 3: must be > 0 and at most", 0),
+            0u)
+      << refusalOf(patch, 48);
+  patch.longitudinalT60Low = 10.0;
+  patch.longitudinalT60High = 1e-4;
+  EXPECT_EQ(refusalOf(patch, 48).rfind("longitudinal_t60_high_s = 1e-04: must be at least ", 0), 0u)
+      << refusalOf(patch, 48);
+  patch.longitudinalT60High.reset();
+  EXPECT_EQ(refusalOf(patch, 48), "(accepted)");
+  patch.longitudinalT60Low.reset();
+  patch.longitudinalT60High = 5.0;
+  EXPECT_EQ(refusalOf(patch, 48), "(accepted)");
+}
+
 TEST(StringVoice, RefusesAnInvalidPatch) {
   StringVoice voice;
   auto with = [](auto change) {
