@@ -440,12 +440,14 @@ constexpr Parameter kTable[] = {
      .model = kString,
      .doc = "The longitudinal wave's own decay time at 0 Hz; unset, it shares the transverse law "
             "by wavenumber (BDZ (49)), which leaves its modes nearly lossless. Set, its law is "
-            "fitted by frequency (σ0 + σ1 ω²ρ/E), at least the transverse σ0. Set alone, "
-            "longitudinal_t60_high_s takes its value."},
+            "fitted by frequency (σ0 + σ1 ω²ρ/E); the transverse σ0 is shared, so v decays at "
+            "least as fast as t60_low_s says. Set alone, longitudinal_t60_high_s takes its "
+            "value."},
     {.name = "loss.longitudinal_t60_high_s",
      .unit = "s",
      .min = 0.01,
      .max = kInf,
+     .maxOf = "loss.longitudinal_t60_low_s",
      .defaultText = "shared",
      .defaultKind = kDerived,
      .model = kString,

@@ -639,6 +639,12 @@ void Loader::checkBounds() {
     if (values_.model ? !appliesTo(p, *values_.model) : p.model != ParameterModel::both) continue;
     const bool upper = !p.maxOf.empty();
     const Parameter& other = values_.row(upper ? p.maxOf : p.minOf);
+    // A derived default has no number to compare: the voice checks what it derives.
+    auto unsetDerived = [&](const Parameter& q) {
+      return q.defaultKind == DefaultKind::derived && !values_.setting(q.name) &&
+             !values_.anchored(q);
+    };
+    if (unsetDerived(p) || unsetDerived(other)) continue;
     if (!invalid_.count(p.name) && !invalid_.count(other.name)) checkBound(p, other, upper);
   }
 }
@@ -699,11 +705,12 @@ Blame Loader::blame(const Parameter& p, int note, bool sayNote) const {
     return {nearest->values.at(p.name).place,
             std::string(p.name) + " = " + approximate(values_.atKey(p, note)) + at};
   const Setting* s = values_.setting(p.name);
-  const std::string value = s                                 ? s->shown
-                            : p.type == ParameterType::choice ? "\"" + values_.word(p.name) + "\""
-                            : p.type == ParameterType::boolean
-                                ? std::string(p.defaultText)
-                                : approximate(values_.number(p.name));
+  const std::string value =
+      s                                 ? s->shown
+      : p.type == ParameterType::choice ? "\"" + values_.word(p.name) + "\""
+      : p.type == ParameterType::boolean || p.defaultKind == DefaultKind::derived
+          ? std::string(p.defaultText)
+          : approximate(values_.number(p.name));
   const Place place = s ? s->place : Place{};
   return {place, said(std::string(p.name), value, place) + (sayNote ? at : "")};
 }

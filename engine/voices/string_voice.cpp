@@ -131,6 +131,22 @@ Felt feltUnder(const StringPatch& patch, const NonlinearString& string) {
   return felt;
 }
 
+// The σ1 that sizes a single grid (transverse, longitudinal rules), where v shares u's spacing h:
+// the bound's loss term is (4/h²) max(σ1_u, σ1_v + Δσ0 h²/4) (schemeLoss), and h <= sqrt(E/ρ) k
+// there bounds the second. On the two grids v's coarse spacing leaves u's σ1 alone.
+double gridSigma1(const StringLoss& loss, const StringPhysics& string, GridRule rule, double k) {
+  if (!loss.ownLongitudinal || rule == GridRule::twoGrid) return loss.sigma1;
+  const double excess = std::max(0.0, loss.longitudinalSigma0 - loss.sigma0);
+  return std::max(loss.sigma1,
+                  loss.longitudinalSigma1 + 0.25 * excess * string.young / string.density * k * k);
+}
+
+// x rounded up to four significant digits: a bound that, as printed, is itself valid.
+double roundedUp(double x) {
+  const double unit = std::pow(10.0, std::floor(std::log10(x)) - 3.0);
+  return std::ceil(x / unit) * unit;
+}
+
 }  // namespace
 
 StringLoss stringLossFromT60(const StringPhysics& string, double t60Low, double t60High,
@@ -156,9 +172,12 @@ StringLoss withLongitudinalLoss(StringLoss loss, const StringPhysics& string, do
   const double omega = 2.0 * std::numbers::pi * highHz;
   loss.ownLongitudinal = true;
   loss.longitudinalSigma0 = std::isfinite(t60Low) ? kLn1000 / t60Low : 0.0;
+  // v decays at least at the shared σ0 (schemeLoss), so σ1_v is fitted from the larger of the
+  // two: the T60 at highHz then holds wherever it is shorter than 6.908 / σ0.
+  const double floor = std::max(loss.sigma0, loss.longitudinalSigma0);
   const double high = std::isfinite(t60High) ? kLn1000 / t60High : 0.0;
   loss.longitudinalSigma1 =
-      (high - loss.longitudinalSigma0) / (omega * omega * string.density / string.young);
+      std::max(0.0, high - floor) / (omega * omega * string.density / string.young);
   return loss;
 }
 
@@ -232,7 +251,8 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
           loss, tuned.physics, patch.longitudinalT60Low.value_or(*patch.longitudinalT60High),
           patch.longitudinalT60High.value_or(*patch.longitudinalT60Low), patch.t60HighHz);
     const bool two = patch.grid == GridRule::twoGrid;
-    tuned = tuneString(patch.string, patch.tuneBy, patch.grid, k, loss.sigma1,
+    tuned = tuneString(patch.string, patch.tuneBy, patch.grid, k,
+                       gridSigma1(loss, tuned.physics, patch.grid, k),
                        patch.gridFactor * (two ? 1.0 : std::sqrt(betaMax)), target,
                        two ? std::max(betaMax, patch.tensionMargin) : 1.0);
     const NonlinearString s(tuned.physics, tuned.grid);
@@ -254,36 +274,49 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
   const bool hasFelt = patch.feltDamper && patch.damperT60 < kNoDamperT60;
   const double epsilon = gaugeShift(patch, string, k);
   string.setTensionRange(betaMax);
-  // The grid was sized with u's σ1; v's own law must keep the bound (44) too, which a decay time
-  // of milliseconds breaks on v's top modes. The shortest stable one is found by bisection.
+  // On the two grids, v's own law must keep the bound (44) on v's coarse grid too, which decay
+  // times of milliseconds break. The refusal names the field the patch set (one set stands for
+  // both) and the shortest stable time, found by bisection on the decay rate.
   const SchemeLoss schemeSide = schemeLoss(loss, tuned.physics);
   if (loss.ownLongitudinal) {
     const double low = patch.longitudinalT60Low.value_or(*patch.longitudinalT60High);
     const double high = patch.longitudinalT60High.value_or(low);
+    const char* lowField =
+        patch.longitudinalT60Low ? "longitudinal_t60_low_s" : "longitudinal_t60_high_s";
+    const char* highField =
+        patch.longitudinalT60High ? "longitudinal_t60_high_s" : "longitudinal_t60_low_s";
     const StringLoss transverse =
         stringLossFromT60(tuned.physics, patch.t60Low, patch.t60High, patch.t60HighHz);
-    auto stable = [&](double lowT60, double highT60) {
-      const SchemeLoss side = schemeLoss(
-          withLongitudinalLoss(transverse, tuned.physics, lowT60, highT60, patch.t60HighHz),
-          tuned.physics);
+    auto t60 = [](double rate) { return rate > 0.0 ? kLn1000 / rate : INFINITY; };
+    auto stable = [&](double lowRate, double highRate) {
+      const SchemeLoss side =
+          schemeLoss(withLongitudinalLoss(transverse, tuned.physics, t60(lowRate), t60(highRate),
+                                          patch.t60HighHz),
+                     tuned.physics);
       string.setLossWeights(side.weights);
       return k <= maxStableStep(string.stiffnessEigenvalueMax(), string.lossOperatorEigenvalueMax(),
                                 side.sigma1);
     };
-    require(stable(low, low), "longitudinal_t60_low_s", low,
-            "longer: v's modes would decay faster than the explicit loss is stable for at this "
-            "rate (the bound (44))");
-    if (!stable(low, high)) {
-      double shortest = low, unstable = high;  // stable(low, shortest), not stable(low, unstable)
+    // The largest stable rate between `from` (stable) and `to` (not), as a time rounded up.
+    auto shortest = [&](double from, double to, auto stableAt) {
       for (int i = 0; i < 60; ++i) {
-        const double mid = std::sqrt(shortest * unstable);
-        (stable(low, mid) ? shortest : unstable) = mid;
+        const double mid = 0.5 * (from + to);
+        (stableAt(mid) ? from : to) = mid;
       }
-      require(false, "longitudinal_t60_high_s", high,
-              "at least " + formatApprox(shortest, 3) +
-                  " s at this rate: shorter, v's highest modes would decay faster than the "
-                  "explicit loss is stable for (the bound (44))");
-    }
+      return formatApprox(roundedUp(t60(from)), 5);
+    };
+    const double lowRate = kLn1000 / low, highRate = kLn1000 / high;
+    const std::string why =
+        " s at this rate: shorter, v's modes would decay faster than the explicit loss is stable "
+        "for on its coarse grid (the bound (44))";
+    // One time set alone stands for both, so `low` and `high` are each the named field's value.
+    if (!stable(lowRate, lowRate))
+      require(false, lowField, low,
+              "at least " + shortest(0.0, lowRate, [&](double x) { return stable(x, x); }) + why);
+    if (!stable(lowRate, highRate))
+      require(false, highField, high, "at least " + shortest(lowRate, highRate, [&](double x) {
+                                        return stable(lowRate, x);
+                                      }) + why);
   }
   string.setLossWeights(schemeSide.weights);
   const HammeredString system(std::move(string), patch.hammer);

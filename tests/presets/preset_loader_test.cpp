@@ -370,8 +370,13 @@ TEST(PresetLoader, TheLongitudinalLossLawIsReadAndChecked) {
   EXPECT_THAT(
       errorsOfText(kStringHead +
                    "[loss]\nlongitudinal_t60_low_s = 2\nlongitudinal_t60_high_s = 3\n"),
-      ElementsAre("test.toml:6:1: loss.longitudinal_t60_high_s = 3 at C2: must be > 0 and at most "
-                  "longitudinal_t60_low_s = 2 (higher longitudinal modes decay faster)"));
+      ElementsAre("test.toml:6:1: loss.longitudinal_t60_high_s = 3: out of range; expected 0.01 "
+                  "… 2 (loss.longitudinal_t60_low_s)"));
+  // A voice's refusal names the time's line and the shortest stable time.
+  EXPECT_THAT(errorsOfText(kStringHead + "[loss]\nlongitudinal_t60_high_s = 0.01\n" +
+                           "longitudinal_t60_low_s = inf\n"),
+              ElementsAre(HasSubstr("test.toml:5:1: loss.longitudinal_t60_high_s = 0.01 at C2: "
+                                    "must be at least ")));
 }
 
 TEST(PresetLoader, VoiceCheckCanBeLeftOut) {

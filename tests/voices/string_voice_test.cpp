@@ -391,22 +391,28 @@ TEST(StringVoice, KeyboardExtremesStayFiniteAndConserveEnergy) {
 // loss's factor per step is 1 − (σ0 + σ')k + O(k²), and the windows' phase leaves under 0.5 %
 // (Störmer–Verlet measures the same). ε ≫ the mode's energy keeps the quadratised V′ linear, as
 // the voice's ε does a strike's (with ε = 0 a lone quadratic V′ hitting zero twice a period is
-// not a linear mode). Sharing the transverse law by wavenumber (BDZ (49)) leaves the mode at
-// σ0 + σ1_u ξ_m, within 5 % of σ0 alone: nearly lossless where σ0 is 0 (the bass).
+// not a linear mode). Where the transverse σ0 is the larger (T60 10 s: 0.69 1/s), v decays at it
+// at 0 Hz and still at the law's 6.10 s at 4 kHz (σ1_v fitted from that σ0). Sharing the transverse
+// law by wavenumber (BDZ (49)) leaves the mode at σ0 + σ1_u ξ_m, within 5 % of σ0 alone: nearly
+// lossless where σ0 is 0 (the bass).
 TEST(StringVoice, LongitudinalModesDecayByTheirOwnLaw) {
   const double k = 1.0 / 48000.0, rv = 0.5, etaV = 1e-9;
   const StringPhysics p = pianoString(48);
   const StringLoss shared = stringLossFromT60(p, 20.0, 4.0, 4000.0);
   const StringLoss own = withLongitudinalLoss(shared, p, 13.8, 6.10, 4000.0);
+  const StringLoss over =
+      withLongitudinalLoss(stringLossFromT60(p, 10.0, 4.0, 4000.0), p, 13.8, 6.10, 4000.0);
   EXPECT_NEAR(own.longitudinalSigma0, rv, 1e-3);
-  const double omega4k = 2.0 * std::numbers::pi * 4000.0;
-  EXPECT_NEAR(own.longitudinalSigma1 * omega4k * omega4k * p.density / p.young,
-              etaV * omega4k * omega4k, 2e-3);  // 6.10 s rounds 6.1043 s
+  const double omega4k = 2.0 * std::numbers::pi * 4000.0,
+               xi4k = omega4k * omega4k * p.density / p.young;
+  EXPECT_NEAR(own.longitudinalSigma1 * xi4k, etaV * omega4k * omega4k, 2e-3);  // 6.10 s: 6.1043 s
   const StringGrid grid = stringGrid(p, GridRule::twoGrid, k, shared.sigma1, 1.0, 1.5);
   const long window = 2400, steps = 24000;
-  for (const bool ownLaw : {true, false}) {
+  const char* names[] = {"own", "shared", "over a larger σ0"};
+  for (const StringLoss* loss : {&own, &shared, &over}) {
+    const char* name = names[loss == &own ? 0 : loss == &shared ? 1 : 2];
     for (const int m : {1, 3}) {
-      const SchemeLoss side = schemeLoss(ownLaw ? own : shared, p);
+      const SchemeLoss side = schemeLoss(*loss, p);
       NonlinearString string(p, grid);
       string.setLossWeights(side.weights);
       const double hv = string.longitudinalSpacing();
@@ -418,7 +424,7 @@ TEST(StringVoice, LongitudinalModesDecayByTheirOwnLaw) {
       InitialState start{Vector::Zero(string.size()), Vector::Zero(string.size())};
       start.q.tail(shape.size()) = 1e-10 * shape;
       SplitSav<NonlinearString> scheme(
-          string, {.k = k, .sigma0 = shared.sigma0, .sigma1 = side.sigma1, .epsilon = 1e-6}, start);
+          string, {.k = k, .sigma0 = loss->sigma0, .sigma1 = side.sigma1, .epsilon = 1e-6}, start);
       double first = 0.0, last = 0.0;
       for (long n = 0; n < steps; ++n) {
         const double a = scheme.q().tail(shape.size()).dot(shape);
@@ -426,10 +432,12 @@ TEST(StringVoice, LongitudinalModesDecayByTheirOwnLaw) {
         scheme.step();
       }
       const double sigma = std::log(first / last) / (2.0 * (steps - window) * k);
-      const double expected =
-          ownLaw ? rv + etaV * (p.young / p.density) * xi : shared.sigma0 + shared.sigma1 * xi;
-      EXPECT_NEAR(sigma, expected, 0.01 * expected) << (ownLaw ? "own" : "shared") << " m " << m;
-      if (!ownLaw) {
+      const double high = 6.907755278982137 / 6.10;  // the law's rate at 4 kHz
+      const double expected = loss == &own      ? rv + etaV * (p.young / p.density) * xi
+                              : loss == &shared ? shared.sigma0 + shared.sigma1 * xi
+                                                : over.sigma0 + (high - over.sigma0) * xi / xi4k;
+      EXPECT_NEAR(sigma, expected, 0.01 * expected) << name << " m " << m;
+      if (loss == &shared) {
         EXPECT_LT(sigma, 1.05 * shared.sigma0);
       }
     }
@@ -446,15 +454,41 @@ TEST(StringVoice, RefusesALongitudinalLawItCannotPlay) {
   EXPECT_EQ(refusalOf(patch, 48).rfind("longitudinal_t60_high_s = 3: must be > 0 and at most", 0),
             0u)
       << refusalOf(patch, 48);
-  patch.longitudinalT60Low = 10.0;
+  // The shortest stable time it names is accepted, and one a little shorter is not; a lossless
+  // 0 Hz end (inf) still has a finite answer.
+  for (const double low : {10.0, static_cast<double>(INFINITY)}) {
+    patch.longitudinalT60Low = low;
+    patch.longitudinalT60High = 1e-4;
+    const std::string refusal = refusalOf(patch, 48);
+    const std::string head = "longitudinal_t60_high_s = 1e-04: must be at least ";
+    ASSERT_EQ(refusal.rfind(head, 0), 0u) << refusal;
+    const double shortest = std::stod(refusal.substr(head.size()));
+    EXPECT_TRUE(std::isfinite(shortest) && shortest > 1e-4) << refusal;
+    patch.longitudinalT60High = shortest;
+    EXPECT_EQ(refusalOf(patch, 48), "(accepted)");
+    patch.longitudinalT60High = 0.99 * shortest;
+    EXPECT_NE(refusalOf(patch, 48), "(accepted)");
+  }
+  // Set alone, the time is named as set, never as the other field.
+  patch.longitudinalT60Low.reset();
   patch.longitudinalT60High = 1e-4;
   EXPECT_EQ(refusalOf(patch, 48).rfind("longitudinal_t60_high_s = 1e-04: must be at least ", 0), 0u)
       << refusalOf(patch, 48);
-  patch.longitudinalT60High.reset();
-  EXPECT_EQ(refusalOf(patch, 48), "(accepted)");
-  patch.longitudinalT60Low.reset();
   patch.longitudinalT60High = 5.0;
   EXPECT_EQ(refusalOf(patch, 48), "(accepted)");
+  patch.longitudinalT60High.reset();
+  patch.longitudinalT60Low = 5.0;
+  EXPECT_EQ(refusalOf(patch, 48), "(accepted)");
+  // On a single grid v shares u's fine spacing; the grid is sized for v's law there, so the
+  // bundled law plays on every rule, even at the transverse bound without stiffness.
+  patch = piano(48);
+  patch.longitudinalT60Low = 13.8;
+  patch.longitudinalT60High = 6.10;
+  patch.string.inertia = 0.0;
+  for (const GridRule rule : {GridRule::transverse, GridRule::longitudinal, GridRule::twoGrid}) {
+    patch.grid = rule;
+    EXPECT_EQ(refusalOf(patch, 48), "(accepted)") << gridRuleName(rule);
+  }
 }
 
 TEST(StringVoice, RefusesAnInvalidPatch) {
