@@ -6,8 +6,10 @@
 #include <numbers>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "instruments/grid.h"
+#include "schemes/linear_loss.h"
 #include "util/format_number.h"
 
 namespace hamiltone {
@@ -107,23 +109,44 @@ double NonlinearString::stiffnessEigenvalueMax() const {
 }
 
 void NonlinearString::setLossWeights(const LossWeights& w) {
-  for (const double x : {w.transverse, w.longitudinalConstant, w.longitudinal})
+  const std::pair<const char*, double> weights[] = {
+      {"transverse", w.transverse},
+      {"longitudinalConstant", w.longitudinalConstant},
+      {"longitudinal", w.longitudinal}};
+  for (const auto& [name, x] : weights)
     if (!(std::isfinite(x) && x >= 0.0))
-      throw std::invalid_argument("loss weight " + formatNumber(x) +
+      throw std::invalid_argument(std::string("loss weight ") + name + " = " + formatNumber(x) +
                                   ": must be a finite number >= 0 (C = M(−Λ) must stay >= 0)");
   lossWeights_ = w;
 }
 
+namespace {
+
+// −D2's top eigenvalue on a grid of m segments of h.
+double topOfMinusD2(int m, double h) {
+  const double s = std::sin((m - 1) * std::numbers::pi / (2.0 * m));
+  return 4.0 / (h * h) * s * s;
+}
+
+}  // namespace
+
 double NonlinearString::lossOperatorEigenvalueMax() const {
-  // The blocks are apart, so the largest is the larger block's: −D2's top eigenvalue on each grid.
-  auto top = [](int m, double h) {
-    const double s = std::sin((m - 1) * std::numbers::pi / (2.0 * m));
-    return 4.0 / (h * h) * s * s;
-  };
-  const double u = lossWeights_.transverse * top(segments_, h_);
+  // The blocks are apart, so the largest is the larger block's.
+  const double u = lossWeights_.transverse * topOfMinusD2(segments_, h_);
   if (grid_.longitudinal < 2) return u;
   return std::max(u, lossWeights_.longitudinalConstant +
-                         lossWeights_.longitudinal * top(grid_.longitudinal, hv_));
+                         lossWeights_.longitudinal * topOfMinusD2(grid_.longitudinal, hv_));
+}
+
+double NonlinearString::maxStableStep(double sigma1) const {
+  const double u = hamiltone::maxStableStep(
+      stiffnessEigenvalueMax(), lossWeights_.transverse * topOfMinusD2(segments_, h_), sigma1);
+  if (grid_.longitudinal < 2) return u;
+  return std::min(u, hamiltone::maxStableStep(
+                         longitudinalEigenvalue(grid_.longitudinal - 1),
+                         lossWeights_.longitudinalConstant +
+                             lossWeights_.longitudinal * topOfMinusD2(grid_.longitudinal, hv_),
+                         sigma1));
 }
 
 void NonlinearString::applyLossOperator(const Vector& a, const Vector& b, Vector& out) const {

@@ -83,6 +83,11 @@ class NonlinearString {
   void applyLossOperator(const Vector& a, const Vector& b, Vector& out) const;
   // λmax(M⁻¹C): the larger of w_u (4/h²) sin²((Mu−1)π/2Mu) and w_v0 + w_v1 (4/h_v²) sin²(…) on v.
   double lossOperatorEigenvalueMax() const;
+  // The bound (44) with the loss σ1, block by block: K and C act on u and on v apart, so the scheme
+  // is stable when each block is — the smaller of maxStableStep(λK, λC, σ1) on u (K at the largest
+  // bend) and on v (K holds T0 there), the top modes of each. Taking the largest λK and λC of the
+  // whole string instead mixes u's stiffness with v's loss and refuses stable laws.
+  double maxStableStep(double sigma1) const;
 
   // Pitch bend: the transverse wave sees the tension β·T0 (the longitudinal wave and V' keep T0,
   // as a tuning peg's small stretch leaves EA − T0 unchanged). stiffnessEigenvalueMax() answers for

@@ -12,8 +12,8 @@
 namespace hamiltone {
 
 // A model with a frequency-dependent loss says which operator it acts through: C = M(−L) >= 0,
-// L its Laplacian, applied to a difference of two states (a − b) into a third vector, and
-// λmax(−L).
+// L its Laplacian (possibly weighted per wave, NonlinearString::LossWeights), applied to a
+// difference of two states (a − b) into a third vector, and λmax(M⁻¹C).
 template <class S>
 concept HasLossOperator = requires(const S& s, const Vector& a, Vector& out) {
   s.applyLossOperator(a, a, out);
@@ -106,7 +106,8 @@ class LinearLoss {
 
 // The largest k for which Ĥ of the split scheme (38) is non-negative: in M-normalised modes the
 // kinetic part is ½|v|²(1 − σ1 k λ_L − k² λ_K / 4), so k² λK/4 + σ1 λL k <= 1 — (44) when σ1 = 0.
-// Exact for a uniform string, whose K and L share eigenvectors and peak at the same mode.
+// Exact for one uniform wave, whose K and L share eigenvectors and peak at the same mode; a string
+// with u and v apart takes it block by block (NonlinearString::maxStableStep).
 inline double maxStableStep(double lambdaK, double lambdaL, double sigma1) {
   const double b = sigma1 * lambdaL;
   if (lambdaK <= 0.0) return b > 0.0 ? 1.0 / b : INFINITY;

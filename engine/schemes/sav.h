@@ -374,7 +374,10 @@ class SavScheme {
                                   " is not a finite number >= 0");
     double lambdaL = 0.0;
     if constexpr (HasLossOperator<S>) lambdaL = system_.lossOperatorEigenvalueMax();
-    const double kMax = maxStableStep(lambda, lambdaL, params_.sigma1);
+    double kMax = maxStableStep(lambda, lambdaL, params_.sigma1);
+    // A system whose K and C act on blocks apart bounds each block (NonlinearString).
+    if constexpr (requires(const S& s) { s.maxStableStep(0.0); })
+      kMax = system_.maxStableStep(params_.sigma1);
     if (params_.k > kMax)
       throw std::invalid_argument(
           "time step k = " + formatNumber(params_.k) +

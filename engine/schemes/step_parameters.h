@@ -13,7 +13,7 @@ namespace hamiltone {
 struct StepParameters {
   double k = 0.0;       // time step, s
   double sigma0 = 0.0;  // mass-proportional loss: force −2σ0 M q', 1/s   (6), (49)
-  double sigma1 = 0.0;  // frequency-dependent loss: force −2σ1 M(−L) q', m²/s (linear_loss.h)
+  double sigma1 = 0.0;  // frequency-dependent loss: force −2σ1 C q', m²/s (linear_loss.h)
   double epsilon = 0.0;  // gauge shift of the quadratised potential, §2.5 (SAV schemes only)
   // Accumulate the energy the loss takes (dissipated(), the balance (50)) — one more pass over
   // the grid per lossy step, which a voice that only needs the sound leaves out.

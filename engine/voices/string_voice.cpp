@@ -131,14 +131,20 @@ Felt feltUnder(const StringPatch& patch, const NonlinearString& string) {
   return felt;
 }
 
-// The σ1 that sizes a single grid (transverse, longitudinal rules), where v shares u's spacing h:
-// the bound's loss term is (4/h²) max(σ1_u, σ1_v + Δσ0 h²/4) (schemeLoss), and h <= sqrt(E/ρ) k
-// there bounds the second. On the two grids v's coarse spacing leaves u's σ1 alone.
+// The σ1 that sizes a single grid (transverse, longitudinal rules), where v shares u's spacing h.
+// v's block of (44) asks h² >= H = c²k² + 4 (σ1_v + Δσ0 H/4) k (K holds T0 on v, Δσ0 the law's
+// σ0 above the shared one: schemeLoss), i.e. H = (c²k² + 4σ1_v k)/(1 − Δσ0 k); u's asks
+// h² >= (a + sqrt(a² + 16κ²k²))/2, a = c²k² + 4σ1 k (minimalSpacing), which reaches H at σ1 =
+// (H − 4κ²k²/H − c²k²)/(4k). Stiffness makes u's the larger on the bundled strings, so the grid
+// changes only where v's law binds (no stiffness, or a law of milliseconds). The two grids put v on
+// its own coarse grid, which the voice then checks.
 double gridSigma1(const StringLoss& loss, const StringPhysics& string, GridRule rule, double k) {
   if (!loss.ownLongitudinal || rule == GridRule::twoGrid) return loss.sigma1;
   const double excess = std::max(0.0, loss.longitudinalSigma0 - loss.sigma0);
-  return std::max(loss.sigma1,
-                  loss.longitudinalSigma1 + 0.25 * excess * string.young / string.density * k * k);
+  const double c2k2 = string.tension / string.linearDensity() * k * k;
+  const double kappa2k2 = string.young * string.inertia / string.linearDensity() * k * k;
+  const double h2 = (c2k2 + 4.0 * loss.longitudinalSigma1 * k) / std::max(1.0 - excess * k, 1e-3);
+  return std::max(loss.sigma1, (h2 - 4.0 * kappa2k2 / h2 - c2k2) / (4.0 * k));
 }
 
 // x rounded up to four significant digits: a bound that, as printed, is itself valid.
@@ -244,15 +250,17 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
   double betaMax = widest;
   TunedString tuned{patch.string, {}};
   StringLoss loss;
+  StringPhysics lossPhysics;  // what `loss` was fitted on: the round's string before its tuning
   for (int round = 0; round < 3; ++round) {
-    loss = stringLossFromT60(tuned.physics, patch.t60Low, patch.t60High, patch.t60HighHz);
+    lossPhysics = tuned.physics;
+    loss = stringLossFromT60(lossPhysics, patch.t60Low, patch.t60High, patch.t60HighHz);
     if (patch.longitudinalT60Low || patch.longitudinalT60High)
       loss = withLongitudinalLoss(
-          loss, tuned.physics, patch.longitudinalT60Low.value_or(*patch.longitudinalT60High),
+          loss, lossPhysics, patch.longitudinalT60Low.value_or(*patch.longitudinalT60High),
           patch.longitudinalT60High.value_or(*patch.longitudinalT60Low), patch.t60HighHz);
     const bool two = patch.grid == GridRule::twoGrid;
     tuned = tuneString(patch.string, patch.tuneBy, patch.grid, k,
-                       gridSigma1(loss, tuned.physics, patch.grid, k),
+                       gridSigma1(loss, lossPhysics, patch.grid, k),
                        patch.gridFactor * (two ? 1.0 : std::sqrt(betaMax)), target,
                        two ? std::max(betaMax, patch.tensionMargin) : 1.0);
     const NonlinearString s(tuned.physics, tuned.grid);
@@ -277,7 +285,7 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
   // On the two grids, v's own law must keep the bound (44) on v's coarse grid too, which decay
   // times of milliseconds break. The refusal names the field the patch set (one set stands for
   // both) and the shortest stable time, found by bisection on the decay rate.
-  const SchemeLoss schemeSide = schemeLoss(loss, tuned.physics);
+  const SchemeLoss schemeSide = schemeLoss(loss, lossPhysics);
   if (loss.ownLongitudinal) {
     const double low = patch.longitudinalT60Low.value_or(*patch.longitudinalT60High);
     const double high = patch.longitudinalT60High.value_or(low);
@@ -286,16 +294,14 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
     const char* highField =
         patch.longitudinalT60High ? "longitudinal_t60_high_s" : "longitudinal_t60_low_s";
     const StringLoss transverse =
-        stringLossFromT60(tuned.physics, patch.t60Low, patch.t60High, patch.t60HighHz);
+        stringLossFromT60(lossPhysics, patch.t60Low, patch.t60High, patch.t60HighHz);
     auto t60 = [](double rate) { return rate > 0.0 ? kLn1000 / rate : INFINITY; };
     auto stable = [&](double lowRate, double highRate) {
-      const SchemeLoss side =
-          schemeLoss(withLongitudinalLoss(transverse, tuned.physics, t60(lowRate), t60(highRate),
-                                          patch.t60HighHz),
-                     tuned.physics);
+      const SchemeLoss side = schemeLoss(withLongitudinalLoss(transverse, lossPhysics, t60(lowRate),
+                                                              t60(highRate), patch.t60HighHz),
+                                         lossPhysics);
       string.setLossWeights(side.weights);
-      return k <= maxStableStep(string.stiffnessEigenvalueMax(), string.lossOperatorEigenvalueMax(),
-                                side.sigma1);
+      return k <= string.maxStableStep(side.sigma1);
     };
     // The largest stable rate between `from` (stable) and `to` (not), as a time rounded up.
     auto shortest = [&](double from, double to, auto stableAt) {

@@ -81,7 +81,8 @@ StringLoss withLongitudinalLoss(StringLoss loss, const StringPhysics& string, do
 // The scheme's σ1 and the string's loss weights (NonlinearString::LossWeights) that give u and v
 // their laws. The scheme's σ0 is common to both waves, so v decays at least at the transverse σ0:
 // its weight w_v0 carries max(0, σ0_v − σ0) / σ1. σ1 is the largest of σ1_u, σ1_v and that excess
-// at the first mode's wavenumber² (π/L)², so no weight exceeds 1.
+// over the first mode's wavenumber² (π/L)²: any positive scale would do (the weights carry the
+// laws); this one is zero only where there is no such loss at all, which lets the scheme skip it.
 struct SchemeLoss {
   double sigma1 = 0.0;
   NonlinearString::LossWeights weights;

@@ -9,6 +9,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <random>
 
@@ -229,10 +230,45 @@ TEST(NonlinearString, WeightedLossOperatorGivesEachWaveItsLaw) {
     for (size_t i = 0; i < expected.size(); ++i)
       EXPECT_NEAR(eig.eigenvalues()[static_cast<Eigen::Index>(i)], expected[i], 1e-9 * top);
     EXPECT_NEAR(string.lossOperatorEigenvalueMax(), top, 1e-9 * top);
+    // Applied to a difference, with the constant part too.
+    const Vector a = randomVector(n, 1.0, 9), b = randomVector(n, 1.0, 10);
+    Vector out(n);
+    string.applyLossOperator(a, b, out);
+    EXPECT_LE((c * (a - b) - out).cwiseAbs().maxCoeff(), 1e-12 * out.cwiseAbs().maxCoeff());
   }
   NonlinearString string(c3(), grid);
   for (const double bad : {-1.0, static_cast<double>(NAN), static_cast<double>(INFINITY)})
     EXPECT_THROW(string.setLossWeights({1.0, bad, 1.0}), std::invalid_argument) << bad;
+}
+
+// The bound (44) block by block: in each block K and C share their modes (sines of the block's
+// grid), so the exact condition is k²λK/4 + σ1 k λC <= 1 mode by mode, and its tightest mode is
+// each block's top one. With v's loss far above u's the string-wide maxima, u's stiffness with v's
+// loss, give a lower bound than the truth — by 0.1 % here, enough to refuse RT-425's longitudinal
+// law on a grid sized at the bound (paper-c3-string's transverse grid, hostile review).
+TEST(NonlinearString, TheStabilityBoundIsTakenBlockByBlock) {
+  const StringGrid grid{120, 12};
+  NonlinearString string(c3(), grid);
+  string.setLossWeights({1.0, 2000.0, 1000.0});
+  const double sigma1 = 2.4e-4;
+  double exact = INFINITY;
+  const double hv = string.longitudinalSpacing();
+  for (int m = 1; m < grid.transverse; ++m) {
+    const double lc = 4.0 / std::pow(string.spacing(), 2) *
+                      std::pow(std::sin(m * std::numbers::pi / (2.0 * grid.transverse)), 2);
+    exact = std::min(exact, maxStableStep(string.transverseEigenvalue(m), lc, sigma1));
+  }
+  for (int m = 1; m < grid.longitudinal; ++m) {
+    const double lc =
+        2000.0 + 100.0 * 4.0 / (hv * hv) *
+                     std::pow(std::sin(m * std::numbers::pi / (2.0 * grid.longitudinal)), 2);
+    exact = std::min(exact, maxStableStep(string.longitudinalEigenvalue(m), lc, sigma1));
+  }
+  EXPECT_NEAR(string.maxStableStep(sigma1), exact, 1e-12 * exact);
+  const double mixed =
+      maxStableStep(string.stiffnessEigenvalueMax(), string.lossOperatorEigenvalueMax(), sigma1);
+  std::printf("block by block %.6g s, string-wide %.6g s\n", exact, mixed);
+  EXPECT_LT(mixed, (1.0 - 5e-4) * exact);
 }
 
 // The paper's first-mode start (70) at α = 300 and the extreme α = 1000 (u = 0.94 m on a 1.26 m

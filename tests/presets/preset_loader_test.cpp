@@ -372,9 +372,10 @@ TEST(PresetLoader, TheLongitudinalLossLawIsReadAndChecked) {
                    "[loss]\nlongitudinal_t60_low_s = 2\nlongitudinal_t60_high_s = 3\n"),
       ElementsAre("test.toml:6:1: loss.longitudinal_t60_high_s = 3: out of range; expected 0.01 "
                   "… 2 (loss.longitudinal_t60_low_s)"));
-  // A voice's refusal names the time's line and the shortest stable time.
+  // A voice's refusal names the time's line and the shortest stable time (at 8× oversampling v's
+  // coarse grid is 8× finer, and its top modes 8× higher).
   EXPECT_THAT(errorsOfText(kStringHead + "[loss]\nlongitudinal_t60_high_s = 0.01\n" +
-                           "longitudinal_t60_low_s = inf\n"),
+                           "longitudinal_t60_low_s = inf\n[scheme]\noversampling = 8\n"),
               ElementsAre(HasSubstr("test.toml:5:1: loss.longitudinal_t60_high_s = 0.01 at C2: "
                                     "must be at least ")));
 }
