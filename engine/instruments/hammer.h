@@ -13,7 +13,7 @@
 namespace hamiltone {
 
 struct HammerFelt {
-  double mass = 9.45e-3;  // M_H, kg            (RT-425 law at C3, docs/instrument-data.md §2.1)
+  double mass = 9.45e-3;       // M_H, kg (RT-425 law at C3, docs/instrument-data.md §2.1)
   double stiffness = 1.347e9;  // K_H, N/m^p
   double exponent = 2.312;     // p
   double position = 0.12;      // strike point x0 / L

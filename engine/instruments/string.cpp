@@ -130,23 +130,26 @@ double topOfMinusD2(int m, double h) {
 
 }  // namespace
 
+double NonlinearString::transverseLossTop() const {
+  return lossWeights_.transverse * topOfMinusD2(segments_, h_);
+}
+
+double NonlinearString::longitudinalLossTop() const {
+  return lossWeights_.longitudinalConstant +
+         lossWeights_.longitudinal * topOfMinusD2(grid_.longitudinal, hv_);
+}
+
 double NonlinearString::lossOperatorEigenvalueMax() const {
   // The blocks are apart, so the largest is the larger block's.
-  const double u = lossWeights_.transverse * topOfMinusD2(segments_, h_);
-  if (grid_.longitudinal < 2) return u;
-  return std::max(u, lossWeights_.longitudinalConstant +
-                         lossWeights_.longitudinal * topOfMinusD2(grid_.longitudinal, hv_));
+  if (grid_.longitudinal < 2) return transverseLossTop();
+  return std::max(transverseLossTop(), longitudinalLossTop());
 }
 
 double NonlinearString::maxStableStep(double sigma1) const {
-  const double u = hamiltone::maxStableStep(
-      stiffnessEigenvalueMax(), lossWeights_.transverse * topOfMinusD2(segments_, h_), sigma1);
+  const double u = hamiltone::maxStableStep(stiffnessEigenvalueMax(), transverseLossTop(), sigma1);
   if (grid_.longitudinal < 2) return u;
-  return std::min(u, hamiltone::maxStableStep(
-                         longitudinalEigenvalue(grid_.longitudinal - 1),
-                         lossWeights_.longitudinalConstant +
-                             lossWeights_.longitudinal * topOfMinusD2(grid_.longitudinal, hv_),
-                         sigma1));
+  return std::min(u, hamiltone::maxStableStep(longitudinalEigenvalue(grid_.longitudinal - 1),
+                                              longitudinalLossTop(), sigma1));
 }
 
 void NonlinearString::applyLossOperator(const Vector& a, const Vector& b, Vector& out) const {

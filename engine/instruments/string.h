@@ -105,6 +105,9 @@ class NonlinearString {
   double longitudinalEigenvalue(int m) const;
 
  private:
+  // λmax(M⁻¹C) on u and on v (v's only where Mv >= 2).
+  double transverseLossTop() const;
+  double longitudinalLossTop() const;
   double singleGridPotential(const Vector& q) const;
   double singleGridGradient(const Vector& q, Vector& grad) const;
   double twoGridPotential(const Vector& q) const;

@@ -372,12 +372,14 @@ class SavScheme {
     if (!(lambda >= 0.0) || !std::isfinite(lambda))
       throw std::invalid_argument("stiffness eigenvalue bound " + formatNumber(lambda) +
                                   " is not a finite number >= 0");
-    double lambdaL = 0.0;
-    if constexpr (HasLossOperator<S>) lambdaL = system_.lossOperatorEigenvalueMax();
-    double kMax = maxStableStep(lambda, lambdaL, params_.sigma1);
     // A system whose K and C act on blocks apart bounds each block (NonlinearString).
-    if constexpr (requires(const S& s) { s.maxStableStep(0.0); })
-      kMax = system_.maxStableStep(params_.sigma1);
+    const double kMax = [&] {
+      if constexpr (requires(const S& s) { s.maxStableStep(0.0); })
+        return system_.maxStableStep(params_.sigma1);
+      double lambdaL = 0.0;
+      if constexpr (HasLossOperator<S>) lambdaL = system_.lossOperatorEigenvalueMax();
+      return maxStableStep(lambda, lambdaL, params_.sigma1);
+    }();
     if (params_.k > kMax)
       throw std::invalid_argument(
           "time step k = " + formatNumber(params_.k) +

@@ -140,7 +140,7 @@ Felt feltUnder(const StringPatch& patch, const NonlinearString& string) {
 // its own coarse grid, which the voice then checks.
 double gridSigma1(const StringLoss& loss, const StringPhysics& string, GridRule rule, double k) {
   if (!loss.ownLongitudinal || rule == GridRule::twoGrid) return loss.sigma1;
-  const double excess = std::max(0.0, loss.longitudinalSigma0 - loss.sigma0);
+  const double excess = loss.longitudinalExcess();
   const double c2k2 = string.tension / string.linearDensity() * k * k;
   const double kappa2k2 = string.young * string.inertia / string.linearDensity() * k * k;
   const double h2 = (c2k2 + 4.0 * loss.longitudinalSigma1 * k) / std::max(1.0 - excess * k, 1e-3);
@@ -189,7 +189,7 @@ StringLoss withLongitudinalLoss(StringLoss loss, const StringPhysics& string, do
 
 SchemeLoss schemeLoss(const StringLoss& loss, const StringPhysics& string) {
   if (!loss.ownLongitudinal) return {.sigma1 = loss.sigma1, .weights = {}};
-  const double excess = std::max(0.0, loss.longitudinalSigma0 - loss.sigma0);
+  const double excess = loss.longitudinalExcess();
   const double firstMode = std::pow(string.length / std::numbers::pi, 2);  // 1 / (π/L)²
   const double scale = std::max({loss.sigma1, loss.longitudinalSigma1, excess * firstMode});
   if (scale == 0.0) return {.sigma1 = 0.0, .weights = {}};
@@ -249,15 +249,18 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
   const double widest = std::pow(2.0, 2.0 * patch.bendRange / 12.0);
   double betaMax = widest;
   TunedString tuned{patch.string, {}};
-  StringLoss loss;
-  StringPhysics lossPhysics;  // what `loss` was fitted on: the round's string before its tuning
+  // v's own law, if any: one time set alone stands for both.
+  const bool ownLaw = patch.longitudinalT60Low || patch.longitudinalT60High;
+  const double lawLow =
+      ownLaw ? patch.longitudinalT60Low.value_or(*patch.longitudinalT60High) : 0.0;
+  const double lawHigh = ownLaw ? patch.longitudinalT60High.value_or(lawLow) : 0.0;
+  StringLoss transverse, loss;  // u's law alone, and with v's
+  StringPhysics lossPhysics;    // what they were fitted on: the round's string before its tuning
   for (int round = 0; round < 3; ++round) {
     lossPhysics = tuned.physics;
-    loss = stringLossFromT60(lossPhysics, patch.t60Low, patch.t60High, patch.t60HighHz);
-    if (patch.longitudinalT60Low || patch.longitudinalT60High)
-      loss = withLongitudinalLoss(
-          loss, lossPhysics, patch.longitudinalT60Low.value_or(*patch.longitudinalT60High),
-          patch.longitudinalT60High.value_or(*patch.longitudinalT60Low), patch.t60HighHz);
+    transverse = stringLossFromT60(lossPhysics, patch.t60Low, patch.t60High, patch.t60HighHz);
+    loss = ownLaw ? withLongitudinalLoss(transverse, lossPhysics, lawLow, lawHigh, patch.t60HighHz)
+                  : transverse;
     const bool two = patch.grid == GridRule::twoGrid;
     tuned = tuneString(patch.string, patch.tuneBy, patch.grid, k,
                        gridSigma1(loss, lossPhysics, patch.grid, k),
@@ -286,15 +289,11 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
   // times of milliseconds break. The refusal names the field the patch set (one set stands for
   // both) and the shortest stable time, found by bisection on the decay rate.
   const SchemeLoss schemeSide = schemeLoss(loss, lossPhysics);
-  if (loss.ownLongitudinal) {
-    const double low = patch.longitudinalT60Low.value_or(*patch.longitudinalT60High);
-    const double high = patch.longitudinalT60High.value_or(low);
+  if (ownLaw) {
     const char* lowField =
         patch.longitudinalT60Low ? "longitudinal_t60_low_s" : "longitudinal_t60_high_s";
     const char* highField =
         patch.longitudinalT60High ? "longitudinal_t60_high_s" : "longitudinal_t60_low_s";
-    const StringLoss transverse =
-        stringLossFromT60(lossPhysics, patch.t60Low, patch.t60High, patch.t60HighHz);
     auto t60 = [](double rate) { return rate > 0.0 ? kLn1000 / rate : INFINITY; };
     auto stable = [&](double lowRate, double highRate) {
       const SchemeLoss side = schemeLoss(withLongitudinalLoss(transverse, lossPhysics, t60(lowRate),
@@ -311,18 +310,18 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
       }
       return formatApprox(roundedUp(t60(from)), 5);
     };
-    const double lowRate = kLn1000 / low, highRate = kLn1000 / high;
+    const double lowRate = kLn1000 / lawLow, highRate = kLn1000 / lawHigh;
     const std::string why =
         " s at this rate: shorter, v's modes would decay faster than the explicit loss is stable "
         "for on its coarse grid (the bound (44))";
-    // One time set alone stands for both, so `low` and `high` are each the named field's value.
+    // One time set alone stands for both, so each is the named field's value.
     if (!stable(lowRate, lowRate))
-      require(false, lowField, low,
+      require(false, lowField, lawLow,
               "at least " + shortest(0.0, lowRate, [&](double x) { return stable(x, x); }) + why);
     if (!stable(lowRate, highRate))
-      require(false, highField, high, "at least " + shortest(lowRate, highRate, [&](double x) {
-                                        return stable(lowRate, x);
-                                      }) + why);
+      require(false, highField, lawHigh, "at least " + shortest(lowRate, highRate, [&](double x) {
+                                           return stable(lowRate, x);
+                                         }) + why);
   }
   string.setLossWeights(schemeSide.weights);
   const HammeredString system(std::move(string), patch.hammer);

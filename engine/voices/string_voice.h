@@ -2,6 +2,7 @@
 // note, oversampled and decimated to the audio rate, with damper, pickups and a guard.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <memory>
 #include <optional>
@@ -72,6 +73,8 @@ struct StringLoss {
   double sigma1 = 0.0;
   bool ownLongitudinal = false;  // false: v takes σ0 and σ1 too (BDZ (49))
   double longitudinalSigma0 = 0.0, longitudinalSigma1 = 0.0;
+  // What v's law asks beyond the shared σ0 at 0 Hz: max(0, σ0_v − σ0).
+  double longitudinalExcess() const { return std::max(0.0, longitudinalSigma0 - sigma0); }
 };
 StringLoss stringLossFromT60(const StringPhysics& string, double t60Low, double t60High,
                              double highHz);
