@@ -1,9 +1,8 @@
-// The string's nonlinear kernels per fine segment, on each instruction set this CPU runs, beside
-// the floor they cannot go under: every segment needs one square root (s_l) and one division (the
-// two grids' 1/(s_l (s_l + 1)), which gives 1/s_l and s_l − 1 by products), or two divisions on
-// the single grid. The floor loops do only that arithmetic over the same number of values, so the
-// summary says how far above it each kernel runs — the bound on the two grids' cost ratio (the
-// fine grid has as many segments as the transverse one, SCHEMES §3b).
+// The string's nonlinear kernels per fine segment, on each instruction set this CPU runs. The
+// single grid needs one square root and two divisions per segment, and is timed beside a loop that
+// does only that arithmetic over as many values: the floor it cannot go under. The two grids need
+// one of each per coarse cell, and per fine segment a difference, a square and the force's products
+// (docs/string-grids.md, "The strain of a cell"). The summary gives both kernels' cost on A0.
 #include <benchmark/benchmark.h>
 
 #include <cmath>
@@ -47,13 +46,12 @@ std::vector<double> paddedU(long m) {
 void twoGrids(benchmark::State& state, Isa isa) {
   const Kernels& k = kernelsFor(isa);
   const std::vector<double> up = paddedU(kFine), eta = wiggle(kCells, 1e-4, 1.3);
-  std::vector<double> scratch(kFine + kMaxLanes), zetaOverS(kFine + kMaxLanes), strain(kCells),
-      sumInverse(kCells), gu(kFine);
+  std::vector<double> scratch(kFine + kMaxLanes), zeta(kFine + kMaxLanes), strain(kCells),
+      inverseStretch(kCells), gu(kFine);
   for (auto _ : state) {
-    k.cellStretches(up.data(), eta.data(), kCells, kRatio, 100.0, zetaOverS.data(), strain.data(),
-                    sumInverse.data());
-    k.fineForces(kCells, kRatio, 7.0, 100.0, strain.data(), scratch.data(), zetaOverS.data(),
-                 gu.data());
+    k.cellStretches(up.data(), eta.data(), kCells, kRatio, 100.0, zeta.data(), strain.data(),
+                    inverseStretch.data());
+    k.fineForces(kCells, kRatio, 7.0, 100.0, strain.data(), scratch.data(), zeta.data(), gu.data());
     benchmark::DoNotOptimize(gu.data());
     benchmark::ClobberMemory();
   }
@@ -72,22 +70,15 @@ void singleGrid(benchmark::State& state, Isa isa) {
   state.counters["t/segment"] = perSegment(kSingle);
 }
 
-// The floors, compiled like the AVX2 kernels (x86-64-v3): what the hardware's divider does alone.
+// The single grid's floor, compiled like the AVX2 kernels (x86-64-v3): what the hardware's divider
+// does alone.
 #if defined(__x86_64__)
 #define FLOOR_TARGET __attribute__((target("arch=x86-64-v3")))
 #else
 #define FLOOR_TARGET
 #endif
 
-FLOOR_TARGET void sqrtAndDivisions(const double* x, double* y, long n, int divisions) {
-  if (divisions == 1) {
-#pragma omp simd
-    for (long l = 0; l < n; ++l) {
-      const double s = __builtin_sqrt(x[l]);
-      y[l] = 1.0 / (s * (s + 1.0));
-    }
-    return;
-  }
+FLOOR_TARGET void sqrtAndDivisions(const double* x, double* y, long n) {
 #pragma omp simd
   for (long l = 0; l < n; ++l) {
     const double s = __builtin_sqrt(x[l]);
@@ -95,11 +86,11 @@ FLOOR_TARGET void sqrtAndDivisions(const double* x, double* y, long n, int divis
   }
 }
 
-void floorLoop(benchmark::State& state, long n, int divisions) {
+void floorLoop(benchmark::State& state, long n) {
   std::vector<double> x(n), y(n);
   for (long l = 0; l < n; ++l) x[l] = 1.0 + 1e-3 * static_cast<double>(l % 7);
   for (auto _ : state) {
-    sqrtAndDivisions(x.data(), y.data(), n, divisions);
+    sqrtAndDivisions(x.data(), y.data(), n);
     benchmark::DoNotOptimize(y.data());
     benchmark::ClobberMemory();
   }
@@ -117,10 +108,8 @@ void registerAll() {
     benchmark::RegisterBenchmark(name("singleGrid", isa).c_str(), &singleGrid, isa);
   }
 #if defined(__x86_64__)
-  if (cpuRuns(Isa::avx2)) {
-    benchmark::RegisterBenchmark("Floor/sqrtOneDivision/avx2", &floorLoop, kFine, 1);
-    benchmark::RegisterBenchmark("Floor/sqrtTwoDivisions/avx2", &floorLoop, kSingle, 2);
-  }
+  if (cpuRuns(Isa::avx2))
+    benchmark::RegisterBenchmark("Floor/sqrtTwoDivisions/avx2", &floorLoop, kSingle);
 #endif
 }
 
@@ -129,15 +118,14 @@ void printSummary(const RecordingReporter& reporter) {
     const auto* r = reporter.find(n);
     return r == nullptr ? -1.0 : r->counters.at("t/segment").value * 1e9;
   };
-  const double floor1 = nsPerSegment("Floor/sqrtOneDivision/avx2");
-  const double floor2 = nsPerSegment("Floor/sqrtTwoDivisions/avx2");
+  const double floor = nsPerSegment("Floor/sqrtTwoDivisions/avx2");
   const double two = nsPerSegment(name("twoGrids", Isa::avx2));
   const double one = nsPerSegment(name("singleGrid", Isa::avx2));
-  if (floor1 <= 0.0 || floor2 <= 0.0 || two <= 0.0 || one <= 0.0) return;
+  if (floor <= 0.0 || two <= 0.0 || one <= 0.0) return;
   std::printf(
-      "\nAVX2, ns per fine segment: two grids %.2f (floor: sqrt + 1 division %.2f, %.2fx), "
-      "one grid %.2f (floor: sqrt + 2 divisions %.2f, %.2fx)\n",
-      two, floor1, two / floor1, one, floor2, one / floor2);
+      "\nAVX2, ns per fine segment: two grids %.2f (a square root and a division per coarse cell), "
+      "one grid %.2f (floor: sqrt + 2 divisions per segment %.2f, %.2fx)\n",
+      two, one, floor, one / floor);
   std::printf(
       "A0: the two grids' nonlinear step costs %.0f ns over %ld segments, the single grid's %.0f "
       "over %ld\n",

@@ -243,18 +243,18 @@ double NonlinearString::singleGridGradient(const Vector& q, Vector& grad) const 
   return 0.5 * c * sum;
 }
 
-// ε_J = (1/r) Σ_{l∈J} (s_l − 1) into strain_J and Σ_{l∈J} 1/s_l into sumInverse_J, with ζ_l/s_l
-// into zetaOverS (SCHEMES §3b).
-void NonlinearString::cellStrains(const Vector& q, double* strain, double* sumInverse,
-                                  double* zetaOverS) const {
+// ε_J = S_J − 1 into strain_J and 1/S_J into inverseStretch_J, S_J = sqrt((1 + η_J)² + Z_J), with
+// ζ_l into zeta (docs/string-grids.md, "The strain of a cell").
+void NonlinearString::cellStrains(const Vector& q, double* strain, double* inverseStretch,
+                                  double* zeta) const {
   const Eigen::Index m = segments_, mv = grid_.longitudinal;
   padded(q.data(), m, work3_.data());
   longitudinalStrains(q.data() + (m - 1), mv, 1.0 / hv_, cell1_.data());
-  kernels_->cellStretches(work3_.data(), cell1_.data(), mv, ratio_, 1.0 / h_, zetaOverS, strain,
-                          sumInverse);
+  kernels_->cellStretches(work3_.data(), cell1_.data(), mv, ratio_, 1.0 / h_, zeta, strain,
+                          inverseStretch);
 }
 
-// SCHEMES §3b: ε_J = (1/r) Σ_{l∈J} (s_l − 1), V' = (EA − T0)/2 Σ_J h_v ε_J².
+// V' = (EA − T0)/2 Σ_J h_v ε_J².
 double NonlinearString::twoGridPotential(const Vector& q) const {
   double* strain = cell2_.data();
   cellStrains(q, strain, cell3_.data(), work1_.data());
@@ -263,27 +263,29 @@ double NonlinearString::twoGridPotential(const Vector& q) const {
   return 0.5 * hv_ * (physics_.young * physics_.area - physics_.tension) * sum;
 }
 
-// With c = (EA − T0) h_u and w_l = c ε_J / s_l (SCHEMES §3b):
-//   ∂V'/∂ζ_l = w_l ζ_l,  ∂V'/∂η_J = Σ_{l∈J} w_l (1 + η_J) = c ε_J (1 + η_J) Σ_{l∈J} 1/s_l,
+// With c = (EA − T0) h_u, ∂ε_J/∂ζ_l = ζ_l/(r S_J) and ∂ε_J/∂η_J = (1 + η_J)/S_J:
+//   ∂V'/∂ζ_l = c (ε_J/S_J) ζ_l,  ∂V'/∂η_J = c r ε_J (1 + η_J)/S_J,
 // then ∇_u V' = D₋ᵀ(∂V'/∂ζ) on the fine grid and ∇_v V' = D₋ᵀ(∂V'/∂η) on the coarse one.
 double NonlinearString::twoGridGradient(const Vector& q, Vector& grad) const {
   const Eigen::Index m = segments_, mv = grid_.longitudinal;
   const double c = (physics_.young * physics_.area - physics_.tension) * h_;
-  double* zetaOverS = work1_.data();
+  double* zeta = work1_.data();
   double* strain = cell2_.data();
-  double* we = cell3_.data();  // Σ 1/s_l, then ∂V'/∂η_J
-  cellStrains(q, strain, we, zetaOverS);
+  double* weight = cell3_.data();  // 1/S_J, then ε_J/S_J
+  cellStrains(q, strain, weight, zeta);
   const double* eta = cell1_.data();
   double sum = 0.0;
   for (Eigen::Index j = 0; j < mv; ++j) {
     sum += strain[j] * strain[j];
-    we[j] *= c * strain[j] * (1.0 + eta[j]);
+    weight[j] *= strain[j];
   }
-  kernels_->fineForces(mv, ratio_, c, 1.0 / h_, strain, scratch_.data(), zetaOverS, grad.data());
+  kernels_->fineForces(mv, ratio_, c, 1.0 / h_, weight, scratch_.data(), zeta, grad.data());
+  const double cr = c * ratio_;
+  auto we = [&](Eigen::Index j) { return cr * weight[j] * (1.0 + eta[j]); };  // ∂V'/∂η_J
   double* gv = grad.data() + (m - 1);
   const double invHv = 1.0 / hv_;
-  for (Eigen::Index j = 0; j < mv - 1; ++j) gv[j] = (we[j] - we[j + 1]) * invHv;
-  endTension_ = physics_.tension * eta[mv - 1] + we[mv - 1] * invHv;
+  for (Eigen::Index j = 0; j < mv - 1; ++j) gv[j] = (we(j) - we(j + 1)) * invHv;
+  endTension_ = physics_.tension * eta[mv - 1] + we(mv - 1) * invHv;
   return 0.5 * hv_ * (physics_.young * physics_.area - physics_.tension) * sum;
 }
 

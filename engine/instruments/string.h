@@ -35,9 +35,9 @@ struct StringGrid {
 // segments, η = D₋v on the coarse ones.
 //   M = ρA diag(h_u I, h_v I)
 //   K = [ h_u (−T0 D2 + EI D2²)   0 ;  0   h_v (−T0 D2) ]                   (65) + stiffness
-//   V' = (EA − T0)/2 Σ_J h_v ε_J²,  ε_J = (1/r) Σ_{l∈J} (s_l − 1),  s_l = sqrt((1 + η_J)² + ζ_l²)
-// the strain averaged over each coarse cell (SCHEMES §3b); with r = 1 it is (65),
-// V' = h (EA − T0)/2 Σ_l (s_l − 1)².
+//   V' = (EA − T0)/2 Σ_J h_v ε_J²,  ε_J = S_J − 1,  S_J = sqrt((1 + η_J)² + (1/r) Σ_{l∈J} ζ_l²)
+// the strain of each coarse cell from its mean square slope (docs/string-grids.md, "The strain of
+// a cell"); with r = 1 it is (65): V' = h (EA − T0)/2 Σ_l (s_l − 1)², s_l the segment's stretch.
 class NonlinearString {
  public:
   static constexpr bool hasStiffness = true;
@@ -112,7 +112,7 @@ class NonlinearString {
   double singleGridGradient(const Vector& q, Vector& grad) const;
   double twoGridPotential(const Vector& q) const;
   double twoGridGradient(const Vector& q, Vector& grad) const;
-  void cellStrains(const Vector& q, double* strain, double* sumInverse, double* zetaOverS) const;
+  void cellStrains(const Vector& q, double* strain, double* inverseStretch, double* zeta) const;
 
   StringPhysics physics_;
   StringGrid grid_;

@@ -12,71 +12,54 @@ constexpr int kLanes = HAMILTONE_KERNEL_LANES;
 static_assert(kLanes <= kMaxLanes);
 
 // Cell by cell, in chunks of four segments on every path (one vector iteration on AVX2 and
-// AVX-512, two on SSE2): a cell's last chunk runs past its r segments into the following cells'
-// (or the padding's), and they write those values again. The loop of one chunk has a fixed trip
-// count, so it vectorises; a loop of r = 8…17 would not, nor would one over the whole grid
-// without spreading each η_J over its r segments first. Four, not eight on AVX-512: a chunk of
-// eight would compute up to 78 % more square roots and divisions than r (r = 9: 16), and those
-// are what the kernel waits on. A cell's sums are four partial sums, one per position in the
-// chunk (its last chunk adds 0 for the segments past the cell), then added as (p0 + p1) +
-// (p2 + p3): they stay in registers, every path adds the same values in the same order (so
-// every path gives the same bits), and cell J's come after cell J + 1's chunks, whose square
-// roots and divisions then run while J's additions wait.
+// AVX-512, two on SSE2): a cell's last chunk runs past its r segments into the following cell's
+// (or the padding's), whose ζ it writes again. The loop of one chunk has a fixed trip count, so it
+// vectorises; a loop of r = 8…17 would not. A cell's Σ ζ_l² is four partial sums, one per position
+// in the chunk (its last chunk adds 0 for the segments past the cell), then added as (p0 + p1) +
+// (p2 + p3): every path adds the same values in the same order, so every path gives the same bits.
+// The square roots and divisions, one of each per cell, then run over the cells.
 constexpr int kChunk = 4;
 
 // Four doubles: one vector register on AVX2 and AVX-512, two on SSE2.
 typedef double Chunk __attribute__((vector_size(kChunk * sizeof(double))));
 
 HAMILTONE_TARGET void cellStretches(const double* up, const double* eta, long mv, int r,
-                                    double invH, double* zetaOverS, double* strain,
-                                    double* sumInverse) {
+                                    double invH, double* zeta, double* strain,
+                                    double* inverseStretch) {
   const Chunk position = {0.0, 1.0, 2.0, 3.0}, zero = {};
   const double invR = 1.0 / r;
-  Chunk excessSum = {}, inverseSum = {};  // cell J − 1's Σ (s_l − 1), Σ 1/s_l by position
-  for (long j = 0; j <= mv; ++j) {
-    Chunk excessNext = {}, inverseNext = {};  // cell J's
-    if (j < mv) {
-      const double aj = (1.0 + eta[j]) * (1.0 + eta[j]), bj = 2.0 * eta[j] + eta[j] * eta[j];
-      const long end = (j + 1) * r;
-      for (long t = j * r; t < end; t += kChunk) {
-        double excess[kChunk], inverse[kChunk];
+  double* meanSquare = strain;  // Z_J, until the last loop
+  for (long j = 0; j < mv; ++j) {
+    Chunk sum = {};
+    const long end = (j + 1) * r;
+    for (long t = j * r; t < end; t += kChunk) {
+      Chunk left, right;
+      __builtin_memcpy(&left, up + t, sizeof left);
+      __builtin_memcpy(&right, up + t + 1, sizeof right);
+      const Chunk z = (right - left) * invH;
+      __builtin_memcpy(zeta + t, &z, sizeof z);
+      sum += position < static_cast<double>(end - t) ? z * z : zero;
+    }
+    meanSquare[j] = ((sum[0] + sum[1]) + (sum[2] + sum[3])) * invR;
+  }
 #pragma omp simd
-        for (int i = 0; i < kChunk; ++i) {
-          const long l = t + i;
-          const double zeta = (up[l + 1] - up[l]) * invH, z2 = zeta * zeta;
-          const double stretch = __builtin_sqrt(aj + z2);
-          const double d = 1.0 / (stretch * (stretch + 1.0));  // one division for all three
-          const double inv = (stretch + 1.0) * d;
-          excess[i] = (bj + z2) * stretch * d;
-          inverse[i] = inv;
-          zetaOverS[l] = zeta * inv;
-        }
-        Chunk e, v;
-        __builtin_memcpy(&e, excess, sizeof e);
-        __builtin_memcpy(&v, inverse, sizeof v);
-        const auto inside = position < static_cast<double>(end - t);
-        excessNext += inside ? e : zero;
-        inverseNext += inside ? v : zero;
-      }
-    }
-    if (j > 0) {
-      strain[j - 1] = ((excessSum[0] + excessSum[1]) + (excessSum[2] + excessSum[3])) * invR;
-      sumInverse[j - 1] = (inverseSum[0] + inverseSum[1]) + (inverseSum[2] + inverseSum[3]);
-    }
-    excessSum = excessNext;
-    inverseSum = inverseNext;
+  for (long j = 0; j < mv; ++j) {
+    const double e = eta[j], z2 = meanSquare[j];
+    const double stretch = __builtin_sqrt((1.0 + e) * (1.0 + e) + z2);
+    strain[j] = (2.0 * e + e * e + z2) / (stretch + 1.0);  // S_J − 1, no cancellation
+    inverseStretch[j] = 1.0 / stretch;
   }
 }
 
-HAMILTONE_TARGET void fineForces(long mv, int r, double c, double invH, const double* strain,
-                                 double* scratch, const double* zetaOverS, double* gu) {
+HAMILTONE_TARGET void fineForces(long mv, int r, double c, double invH, const double* weight,
+                                 double* scratch, const double* zeta, double* gu) {
   const long m = mv * r;
-  double* w = scratch;  // ∂V'/∂ζ_l = c ε_J ζ_l/s_l, in the chunks of cellStretches
+  double* w = scratch;  // ∂V'/∂ζ_l = c weight_J ζ_l, in the chunks of cellStretches
   for (long j = 0; j < mv; ++j) {
-    const double wj = c * strain[j];
+    const double wj = c * weight[j];
     for (long t = j * r; t < (j + 1) * r; t += kChunk) {
 #pragma omp simd
-      for (int i = 0; i < kChunk; ++i) w[t + i] = zetaOverS[t + i] * wj;
+      for (int i = 0; i < kChunk; ++i) w[t + i] = zeta[t + i] * wj;
     }
   }
 #pragma omp simd

@@ -16,19 +16,20 @@ constexpr int kMaxLanes = 8;  // doubles in the widest vector register (AVX-512)
 struct Kernels {
   Isa isa;
   const char* name;
-  // The two grids' strains (SCHEMES §3b): with up the padded u (u_0 = u_m = 0, m = mv r) and
-  // η_J the coarse strains, each fine segment's s_l = sqrt((1 + η_J)² + ζ_l²), ζ_l = (up[l+1] −
-  // up[l]) invH; sets zetaOverS_l = ζ_l/s_l, strain_J = (1/r) Σ_{l∈J} (s_l − 1) (as (b + ζ²)/(s +
-  // 1), b = 2η + η²: no cancellation at small strain) and sumInverse_J = Σ_{l∈J} 1/s_l, each sum
-  // as four partial sums over l ≡ 0, 1, 2, 3 (mod 4) from the cell's first segment, added as
-  // (p0 + p1) + (p2 + p3) on every path. The loops run in whole chunks of four segments past the
-  // last one: up holds m + kMaxLanes values (finite: zeros past u_m), zetaOverS m + kMaxLanes.
+  // The two grids' strains (docs/string-grids.md): with up the padded u (u_0 = u_m = 0, m = mv r)
+  // and η_J the coarse strains, each fine segment's slope ζ_l = (up[l+1] − up[l]) invH into zeta,
+  // each cell's mean square slope Z_J = (1/r) Σ_{l∈J} ζ_l² (four partial sums over l ≡ 0, 1, 2, 3
+  // (mod 4) from the cell's first segment, added as (p0 + p1) + (p2 + p3) on every path), its
+  // stretch S_J = sqrt((1 + η_J)² + Z_J), strain_J = S_J − 1 (as (2η + η² + Z)/(S + 1): no
+  // cancellation at small strain) and inverseStretch_J = 1/S_J. The loops run in whole chunks of
+  // four segments past the last one: up holds m + kMaxLanes values (finite: zeros past u_m), zeta
+  // m + kMaxLanes.
   void (*cellStretches)(const double* up, const double* eta, long mv, int r, double invH,
-                        double* zetaOverS, double* strain, double* sumInverse);
-  // ∇_u V' = D₋ᵀ(c strain_J ζ_l/s_l): gu_l = (w_l − w_{l+1}) invH, l < m − 1, zetaOverS as
-  // cellStretches left it. scratch: m + kMaxLanes doubles.
-  void (*fineForces)(long mv, int r, double c, double invH, const double* strain, double* scratch,
-                     const double* zetaOverS, double* gu);
+                        double* zeta, double* strain, double* inverseStretch);
+  // ∇_u V' = D₋ᵀ(c weight_J ζ_l): gu_l = (w_l − w_{l+1}) invH, l < m − 1, zeta as cellStretches
+  // left it. scratch: m + kMaxLanes doubles.
+  void (*fineForces)(long mv, int r, double c, double invH, const double* weight, double* scratch,
+                     const double* zeta, double* gu);
   // One grid (BDZ (65)): with up, vp the padded u and v (m + 1 values), ζ_l, η_l their strains
   // and φ_l = (s_l − 1)/s_l, ∂V'/∂ζ_l = c φ_l ζ_l into wz and ∂V'/∂η_l = c φ_l (1 + η_l) into we
   // (m each), gu = D₋ᵀwz and gv = D₋ᵀwe (m − 1 each); returns Σ (s_l − 1)².

@@ -106,10 +106,10 @@ TEST(NonlinearString, EndTensionIsHookesLawOfTheLastCell) {
   }
 }
 
-// Mv = 1 leaves no longitudinal unknown: V' = (EA − T0) L ε² / 2 with ε = (ℓ − L)/L, ℓ the discrete
-// length of the string, and the force on u is that of the extra tension (EA − T0) ε along each
-// segment: ∂V'/∂ζ_l = h (EA − T0) ε ζ_l / s_l — Kirchhoff–Carrier's tension from the mean strain,
-// with the segment's direction cosine exact.
+// Mv = 1 leaves no longitudinal unknown: V' = (EA − T0) L ε² / 2 with ε = S − 1, S = sqrt(1 + Z),
+// Z = (1/M) Σ ζ_l² the string's mean square slope, and the force on u is that of the extra tension
+// (EA − T0) ε along the string: ∂V'/∂ζ_l = h (EA − T0) ε ζ_l / S. To leading order ε = Z/2 =
+// (1/2L) ∫ u_x² dx: Kirchhoff–Carrier's tension from the mean strain, the same everywhere.
 TEST(NonlinearString, OneCellIsTheKirchhoffCarrierString) {
   const StringPhysics p = c3();
   const int mu = 30;
@@ -117,25 +117,49 @@ TEST(NonlinearString, OneCellIsTheKirchhoffCarrierString) {
   ASSERT_EQ(string.size(), mu - 1);
   const Vector q = randomVector(string.size(), 5e-3, 3);
   const double h = string.spacing();
-  std::vector<double> zeta(mu), s(mu);
-  double length = 0.0;
+  std::vector<double> zeta(mu);
+  double meanSquare = 0.0;
   for (int l = 0; l < mu; ++l) {
     zeta[l] = ((l < mu - 1 ? q[l] : 0.0) - (l > 0 ? q[l - 1] : 0.0)) / h;
-    s[l] = std::sqrt(1.0 + zeta[l] * zeta[l]);
-    length += h * s[l];
+    meanSquare += zeta[l] * zeta[l] / mu;
   }
-  const double strain = (length - p.length) / p.length, ea = p.young * p.area - p.tension;
+  const double stretch = std::sqrt(1.0 + meanSquare), strain = stretch - 1.0;
+  const double ea = p.young * p.area - p.tension;
+  EXPECT_NEAR(strain, 0.5 * meanSquare, 0.2 * meanSquare * meanSquare);  // Z/2 − Z²/8 + …
   const double expected = 0.5 * ea * p.length * strain * strain;
   Vector grad(string.size());
   EXPECT_NEAR(string.splitGradient(q, grad), expected, 1e-9 * expected);
-  // The pull on the end: the extra tension along the last segment, (EA − T0) ε mean(1/s_l) — the
-  // whole string's, as Kirchhoff–Carrier's tension is the same everywhere.
-  double meanInverse = 0.0;
-  for (int l = 0; l < mu; ++l) meanInverse += 1.0 / (s[l] * mu);
-  EXPECT_NEAR(string.endTension(), ea * strain * meanInverse, 1e-9 * ea * strain);
+  // The pull on the end: the extra tension along the string's mean direction, (EA − T0) ε / S.
+  EXPECT_NEAR(string.endTension(), ea * strain / stretch, 1e-9 * ea * strain);
   for (int j = 0; j < mu - 1; ++j) {  // D₋ᵀ of the segment forces
-    const double force = ea * strain * (zeta[j] / s[j] - zeta[j + 1] / s[j + 1]);
+    const double force = ea * strain / stretch * (zeta[j] - zeta[j + 1]);
     EXPECT_NEAR(grad[j], force, 1e-9 * ea * strain) << j;
+  }
+}
+
+// A cell's strain comes from its mean square slope, S = sqrt(1 + Z), where the mean of the exact
+// stretches of its segments (SCHEMES §3b) takes mean sqrt(1 + ζ_l²): √ is concave, so S − 1 is the
+// larger, by at most max|f''|/2 · var(ζ²) = var(ζ²)/8 (f(x) = sqrt(1 + x), x >= 0). On a struck
+// string's slopes of a few percent that is a few 1e-4 of the strain: the same geometric tension.
+TEST(NonlinearString, ACellsStrainIsTheMeanStretchWithinTheSlopesVariance) {
+  const StringPhysics p = c3();
+  const int mu = 24;
+  const NonlinearString string(p, StringGrid{mu, 1});
+  const double h = string.spacing(), ea = p.young * p.area - p.tension;
+  for (unsigned seed = 0; seed < 4; ++seed) {
+    const Vector q = randomVector(string.size(), 2e-3, seed);
+    double z2 = 0.0, z4 = 0.0, meanStretch = 0.0;
+    for (int l = 0; l < mu; ++l) {
+      const double zeta = ((l < mu - 1 ? q[l] : 0.0) - (l > 0 ? q[l - 1] : 0.0)) / h;
+      z2 += zeta * zeta / mu;
+      z4 += zeta * zeta * zeta * zeta / mu;
+      meanStretch += (std::sqrt(1.0 + zeta * zeta) - 1.0) / mu;
+    }
+    const double strain = std::sqrt(2.0 * string.splitPotential(q) / (ea * p.length));
+    const double variance = z4 - z2 * z2;
+    EXPECT_GE(strain - meanStretch, -1e-12 * strain) << seed;
+    EXPECT_LE(strain - meanStretch, variance / 8.0 + 1e-12 * strain) << seed;
+    EXPECT_LT(strain - meanStretch, 1e-3 * strain) << seed;
   }
 }
 

@@ -89,19 +89,17 @@ TEST(Kernels, TwoGridStrainsAndForcesAreTheFormulasOnEveryPath) {
       up.front() = 0.0;
       std::fill(up.begin() + m, up.end(), 0.0);
       const std::vector<double> eta = randomArray(mv, 1e-4, 10);
-      std::vector<double> zeta(m), strain(mv), sumInverse(mv), grad(m - 1);
+      std::vector<double> zeta(m), strain(mv), inverse(mv), grad(m - 1);
       for (long j = 0; j < mv; ++j) {
-        const double aj = (1.0 + eta[j]) * (1.0 + eta[j]), bj = 2.0 * eta[j] + eta[j] * eta[j];
-        double e[4] = {}, i[4] = {};  // by position l − J r (mod 4)
+        double z2[4] = {};  // by position l − J r (mod 4)
         for (long l = j * r; l < (j + 1) * r; ++l) {
-          const double z = (up[l + 1] - up[l]) * 100.0, s = std::sqrt(aj + z * z);
-          const double d = 1.0 / (s * (s + 1.0));
-          e[(l - j * r) % 4] += (bj + z * z) * s * d;
-          i[(l - j * r) % 4] += (s + 1.0) * d;
-          zeta[l] = z * ((s + 1.0) * d);
+          zeta[l] = (up[l + 1] - up[l]) * 100.0;
+          z2[(l - j * r) % 4] += zeta[l] * zeta[l];
         }
-        strain[j] = ((e[0] + e[1]) + (e[2] + e[3])) * (1.0 / r);
-        sumInverse[j] = (i[0] + i[1]) + (i[2] + i[3]);
+        const double mean = ((z2[0] + z2[1]) + (z2[2] + z2[3])) * (1.0 / r);
+        const double s = std::sqrt((1.0 + eta[j]) * (1.0 + eta[j]) + mean);
+        strain[j] = (2.0 * eta[j] + eta[j] * eta[j] + mean) / (s + 1.0);
+        inverse[j] = 1.0 / s;
       }
       for (long l = 0; l + 1 < m; ++l)
         grad[l] =
@@ -112,7 +110,7 @@ TEST(Kernels, TwoGridStrainsAndForcesAreTheFormulasOnEveryPath) {
         k->cellStretches(up.data(), eta.data(), mv, r, 100.0, z.data(), s.data(), i.data());
         EXPECT_TRUE(std::equal(zeta.begin(), zeta.end(), z.begin())) << k->name << " r " << r;
         EXPECT_EQ(s, strain) << k->name << " r = " << r << " mv = " << mv;
-        EXPECT_EQ(i, sumInverse) << k->name << " r = " << r << " mv = " << mv;
+        EXPECT_EQ(i, inverse) << k->name << " r = " << r << " mv = " << mv;
         k->fineForces(mv, r, 7.0, 100.0, s.data(), scratch.data(), z.data(), g.data());
         EXPECT_EQ(g, grad) << k->name << " r = " << r << " mv = " << mv;
       }

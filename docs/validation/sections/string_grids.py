@@ -202,7 +202,8 @@ def run(ctx):
     out.append(
         "**Claim (SCHEMES §3b, issue 15 item 6).** At 48 kHz and oversampling 1 the two nested "
         "grids (u on the transverse grid sized for 1.5 T0, v on a coarse grid with h_v ≥ 1.05 "
-        "√(E/ρ) k) give the pitch glide of the converged string within 15 % wherever it exceeds "
+        "√(E/ρ) k, each cell's strain from its mean square slope: docs/string-grids.md) give "
+        "the pitch glide of the converged string within 15 % wherever it exceeds "
         "1 cent, the energy between the linear partials (phantom partials, longitudinal modes) "
         "within 3 dB, and cost at most 0.7 of the single transverse grid.\n")
     out.append(
@@ -380,9 +381,11 @@ def run(ctx):
            " On cost: " + ", ".join(f"{name[m]} {key_cost[m]:.2f}" for m in keys
                                     if key_cost[m] > COST_RATIO)
            + f" of the transverse grid's time, against at most {COST_RATIO:g}. The unknowns "
-           "fall further than the time (table above): the work per fine segment — the stiffness "
-           "stencil on u and a square root per segment in V′ — is the same on both rules, and "
-           "only v's share shrinks"
+           "fall further than the time (table above): u's stencils and the SAV passes over u cost "
+           "the same on both rules, and so does the work every step does whatever the grid (the "
+           "SAV's scalar part, the hammer, the pickups), most of a short string's step; the two "
+           "grids save v's share of the unknowns and the square roots of V′ (one per coarse cell, "
+           "against one per segment)"
            + (f"; on {', '.join(finer)} u's grid is even finer on the two-grid rule (sized for "
               "1.5 T0) than on the transverse rule (sized for the bend range's tension)"
               if finer else "") + ".")
