@@ -105,14 +105,18 @@ TEST(Kernels, TwoGridStrainsAndForcesAreTheFormulasOnEveryPath) {
         grad[l] =
             (zeta[l] * (7.0 * strain[l / r]) - zeta[l + 1] * (7.0 * strain[(l + 1) / r])) * 100.0;
       for (const Kernels* k : paths) {
+        // gu is followed by the caller's other coordinates, which fineForces must leave alone.
         std::vector<double> scratch(m + kMaxLanes, NAN), z(m + kMaxLanes, NAN), s(mv), i(mv),
-            g(m - 1);
+            g(m - 1 + kMaxLanes, -1.0);
         k->cellStretches(up.data(), eta.data(), mv, r, 100.0, z.data(), s.data(), i.data());
         EXPECT_TRUE(std::equal(zeta.begin(), zeta.end(), z.begin())) << k->name << " r " << r;
         EXPECT_EQ(s, strain) << k->name << " r = " << r << " mv = " << mv;
         EXPECT_EQ(i, inverse) << k->name << " r = " << r << " mv = " << mv;
         k->fineForces(mv, r, 7.0, 100.0, s.data(), scratch.data(), z.data(), g.data());
-        EXPECT_EQ(g, grad) << k->name << " r = " << r << " mv = " << mv;
+        EXPECT_TRUE(std::equal(grad.begin(), grad.end(), g.begin()))
+            << k->name << " r = " << r << " mv = " << mv;
+        EXPECT_TRUE(std::all_of(g.begin() + (m - 1), g.end(), [](double x) { return x == -1.0; }))
+            << k->name << " wrote past its last segment, r = " << r << " mv = " << mv;
       }
     }
   }
