@@ -1,7 +1,7 @@
 // The string's nonlinear kernels per fine segment, on each instruction set this CPU runs. The
 // single grid needs one square root and two divisions per segment, and is timed beside a loop that
 // does only that arithmetic over as many values: the floor it cannot go under. The two grids need
-// one of each per coarse cell, and per fine segment a difference, a square and the force's products
+// the same per coarse cell, and per fine segment a difference, a square and the force's products
 // (docs/string-grids.md, "The strain of a cell"). The summary gives both kernels' cost on A0.
 #include <benchmark/benchmark.h>
 
@@ -123,7 +123,8 @@ void printSummary(const RecordingReporter& reporter) {
   const double one = nsPerSegment(name("singleGrid", Isa::avx2));
   if (floor <= 0.0 || two <= 0.0 || one <= 0.0) return;
   std::printf(
-      "\nAVX2, ns per fine segment: two grids %.2f (a square root and a division per coarse cell), "
+      "\nAVX2, ns per fine segment: two grids %.2f (a square root and two divisions per coarse "
+      "cell), "
       "one grid %.2f (floor: sqrt + 2 divisions per segment %.2f, %.2fx)\n",
       two, one, floor, one / floor);
   std::printf(

@@ -17,7 +17,7 @@ static_assert(kLanes <= kMaxLanes);
 // vectorises; a loop of r = 8…17 would not. A cell's Σ ζ_l² is four partial sums, one per position
 // in the chunk (its last chunk adds 0 for the segments past the cell), then added as (p0 + p1) +
 // (p2 + p3): every path adds the same values in the same order, so every path gives the same bits.
-// The square roots and divisions, one of each per cell, then run over the cells.
+// The square roots and divisions, one and two per cell, then run over the cells.
 constexpr int kChunk = 4;
 
 // Four doubles: one vector register on AVX2 and AVX-512, two on SSE2.
