@@ -175,8 +175,12 @@ class JackPlay : public ::testing::Test {
     while (list.find(":hamiltone-in") == std::string::npos && Clock::now() < deadline &&
            !player_->wait(0.1))
       list = ports().value_or("");
+    const std::optional<int> ended = player_->wait(0.0);
     ASSERT_NE(list.find(":hamiltone-in"), std::string::npos)
-        << "the player's MIDI port did not appear:\n"
+        << "the player's MIDI port did not appear ("
+        << (ended ? "the player ended with exit code " + std::to_string(*ended)
+                  : std::string("the player still runs"))
+        << "; the server's ports: " << ports().value_or("none") << "):\n"
         << slurp(dir_ / "player.err");
   }
 
