@@ -124,8 +124,7 @@ void printSummary(const RecordingReporter& reporter) {
   if (floor <= 0.0 || two <= 0.0 || one <= 0.0) return;
   std::printf(
       "\nAVX2, ns per fine segment: two grids %.2f (a square root and two divisions per coarse "
-      "cell), "
-      "one grid %.2f (floor: sqrt + 2 divisions per segment %.2f, %.2fx)\n",
+      "cell), one grid %.2f (floor: sqrt + 2 divisions per segment %.2f, %.2fx)\n",
       two, one, floor, one / floor);
   std::printf(
       "A0: the two grids' nonlinear step costs %.0f ns over %ld segments, the single grid's %.0f "

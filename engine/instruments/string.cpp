@@ -270,22 +270,23 @@ double NonlinearString::twoGridGradient(const Vector& q, Vector& grad) const {
   const Eigen::Index m = segments_, mv = grid_.longitudinal;
   const double c = (physics_.young * physics_.area - physics_.tension) * h_;
   double* zeta = work1_.data();
-  double* strain = cell2_.data();
+  double* we = cell2_.data();      // ε_J, then ∂V'/∂η_J
   double* weight = cell3_.data();  // 1/S_J, then ε_J/S_J
-  cellStrains(q, strain, weight, zeta);
+  cellStrains(q, we, weight, zeta);
   const double* eta = cell1_.data();
+  const double cr = c * ratio_;
   double sum = 0.0;
   for (Eigen::Index j = 0; j < mv; ++j) {
-    sum += strain[j] * strain[j];
-    weight[j] *= strain[j];
+    const double strain = we[j];
+    sum += strain * strain;
+    weight[j] *= strain;
+    we[j] = cr * weight[j] * (1.0 + eta[j]);
   }
   kernels_->fineForces(mv, ratio_, c, 1.0 / h_, weight, scratch_.data(), zeta, grad.data());
-  const double cr = c * ratio_;
-  auto we = [&](Eigen::Index j) { return cr * weight[j] * (1.0 + eta[j]); };  // ∂V'/∂η_J
   double* gv = grad.data() + (m - 1);
   const double invHv = 1.0 / hv_;
-  for (Eigen::Index j = 0; j < mv - 1; ++j) gv[j] = (we(j) - we(j + 1)) * invHv;
-  endTension_ = physics_.tension * eta[mv - 1] + we(mv - 1) * invHv;
+  for (Eigen::Index j = 0; j < mv - 1; ++j) gv[j] = (we[j] - we[j + 1]) * invHv;
+  endTension_ = physics_.tension * eta[mv - 1] + we[mv - 1] * invHv;
   return 0.5 * hv_ * (physics_.young * physics_.area - physics_.tension) * sum;
 }
 
