@@ -690,14 +690,19 @@ size_t columns(std::string_view s) {
       s.begin(), s.end(), [](char c) { return (static_cast<unsigned char>(c) & 0xC0) != 0x80; }));
 }
 
-// Appends a cell and pads the line to column `at` + `width`, where the cell should end, with at
-// least one space; `at` moves on to there. A cell that overflows takes its columns from the next
-// one rather than widening the line.
+// Appends a cell and pads the line to column `at` + `width`, where the cell should end; `at` moves
+// on to there. A cell that leaves no space before that column ends its line: the row's next cells
+// go on a line of their own, each under its heading.
 void cell(std::string& out, std::string_view s, size_t width, size_t& at) {
   const size_t used = columns(out.substr(out.rfind('\n') + 1)) + columns(s);
   at += width;
   out += s;
-  out.append(at > used ? at - used : 1, ' ');
+  if (at > used) {
+    out.append(at - used, ' ');
+  } else {
+    out += '\n';
+    out.append(at, ' ');
+  }
 }
 
 // Appends `words` wrapped to 100 columns, each line indented by `indent` spaces.

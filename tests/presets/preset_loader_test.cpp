@@ -6,6 +6,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iterator>
@@ -663,6 +664,50 @@ TEST(PresetParameters, PrintedTableListsEveryParameterIn100Columns) {
     EXPECT_LE(columns, 100u) << line;
     start = end == std::string::npos ? table.size() : end + 1;
   }
+}
+
+// Every row's last cell, the models it applies to, starts under the heading "model", on the row's
+// own line or, when a cell before it is wider than its column (a range such as
+// "0.01 … longitudinal_t60_low_s"), on the line that continues the row.
+TEST(PresetParameters, PrintedTableKeepsEveryCellUnderItsHeading) {
+  const std::string table = parameterTable();
+  std::vector<std::string> lines;
+  for (size_t start = 0; start < table.size();) {
+    const size_t end = std::min(table.find('\n', start), table.size());
+    lines.push_back(table.substr(start, end - start));
+    start = end + 1;
+  }
+  // The text of a line from a column on (columns, not bytes: the ranges hold "…").
+  auto from = [](const std::string& line, size_t column) {
+    size_t at = 0, i = 0;
+    for (; i < line.size() && at < column; ++i) at += (line[i] & 0xC0) != 0x80 ? 1 : 0;
+    while (i < line.size() && (line[i] & 0xC0) == 0x80) ++i;
+    return at == column ? line.substr(i) : std::string();
+  };
+  const auto header = std::find_if(lines.begin(), lines.end(),
+                                   [](const std::string& l) { return l.rfind("  name ", 0) == 0; });
+  ASSERT_NE(header, lines.end());
+  const size_t model = header->find("model");
+  int continued = 0;
+  for (const Parameter& p : parameters()) {
+    const std::string start = "  " + std::string(p.name) + " ";
+    const auto row = std::find_if(lines.begin(), lines.end(), [&](const std::string& l) {
+      return l.rfind(start, 0) == 0 && l != *header;  // the parameter "name" is a heading too
+    });
+    ASSERT_NE(row, lines.end()) << p.name;
+    std::string last = from(*row, model);
+    if (last.empty()) {  // the row goes on below
+      ASSERT_NE(row + 1, lines.end()) << p.name;
+      EXPECT_GT(row[1].find_first_not_of(' '), start.size()) << p.name << ": " << row[1];
+      last = from(row[1], model);
+      ++continued;
+    }
+    EXPECT_TRUE(last.rfind("both", 0) == 0 || last.rfind("string", 0) == 0 ||
+                last.rfind("plate", 0) == 0)
+        << p.name << ": the models start at column " << model << " of \"" << *row << "\", got \""
+        << last << "\"";
+  }
+  EXPECT_GE(continued, 1) << "no row is wider than its columns: the continuation is untested";
 }
 
 TEST(PresetNotes, NamesAndNumbers) {
