@@ -75,6 +75,31 @@ def common_bands_diff(g, ref, partials_g, partials_ref):
     return 10 * math.log10(share_g / share_ref)
 
 
+REGIONS_KHZ = (0, 0.5, 1, 2, 3, 4, 6, 8, 10, 14, 20)  # where a between-partials miss is placed
+
+
+def largest_differences(g, ref, partials_g, partials_ref, count=2):
+    """The frequency regions where the two-grid's and the reference's between-partials energy
+    (each outside its own partials' bands, in dB re its own total) differ most in power: a list of
+    (from kHz, to kHz, two-grid dB, reference dB), the largest first."""
+    found = []
+    for lo, hi in zip(REGIONS_KHZ[:-1], REGIONS_KHZ[1:]):
+        shares = []
+        for run, partials in ((g, partials_g), (ref, partials_ref)):
+            f, power = run["f"], run["mag"] ** 2
+            audible = (f > 0) & (f <= TOP_HZ)
+            region = (f > 1000 * lo) & (f <= 1000 * hi)
+            near = np.zeros(len(f), dtype=bool)
+            for fm in partials:
+                a, b = np.searchsorted(f, [fm - BAND, fm + BAND])
+                near[a:b] = True
+            shares.append(float(np.sum(power[audible & region & ~near]) / np.sum(power[audible])))
+        found.append((abs(shares[0] - shares[1]), lo, hi,
+                      *(10 * math.log10(x) if x > 0 else -math.inf for x in shares)))
+    found.sort(reverse=True)
+    return [row[1:] for row in found[:count]]
+
+
 def window_floor():
     """The between-partials level of a pure sinusoid (of an ideal linear string): the window's own
     leakage outside ±BAND, in dB."""
@@ -283,7 +308,12 @@ def run(ctx):
                                  if max(g["phantom"], ref["phantom"]) < floor + 10 else "")
                               + f"; {common:+.1f} dB outside both configurations' bands"
                               + (": where the bands lie, not the sound" if abs(common)
-                                 <= PHANTOM_DB else "") + ")")
+                                 <= PHANTOM_DB else "") + "; the largest differences at "
+                              + " and ".join(f"{lo:g}–{hi:g} kHz ({a:.1f} against {b:.1f} dB)"
+                                             for lo, hi, a, b in largest_differences(
+                                                 g, ref, partials[midi, "two-grid", "transverse"],
+                                                 partials[midi, "longitudinal", "transverse"]))
+                              + ")")
             lines.append(
                 f"| {g['note']} | {v} | {float(g['hammer_m_s']):.3g} | {t['glide']:+.2f} | "
                 f"{g['glide']:+.2f} | {ref['glide']:+.2f} | "
