@@ -49,26 +49,10 @@ std::string stablePortName(const std::string& name) {
   return name.substr(0, space);
 }
 
-// On JACK, RtMidi 5 activates its client as it makes it, before the port is registered, and
-// closePort() (the destructor's too) unregisters the port while the client is still active. libjack
-// (jackd2 1.9.21) walks the client's port list without a lock on its notification thread whenever
-// the server recomputes latencies — on any graph change, such as the player's own audio client
-// deactivating just before — so unregistering then can free the list node being read: a segfault
-// in libjack, the player dead without a word and its recording lost (once in the e2e tests' runs,
-// kernel log "segfault … in libjack.so.0.1.0[12986,…]"; a loop that makes and destroys a virtual
-// port beside a client changing the graph crashed so every time, and never without the
-// unregister). So on JACK a port once made is never unregistered: close() only stops the
-// callback, reconnect() connects the same port again (RtMidi's openPort keeps a port it has), and
-// the client with its port is left to the end of the process, when the server drops it.
 struct MidiInput::Impl {
   std::unique_ptr<RtMidiIn> in;
   std::unique_ptr<RtMidiIn> watcher;  // lists the ports while `in` has one open
   bool open = false;                  // a port and the callback are set
-  bool jack = false;
-  bool registered = false;  // on JACK, `in` has a port: it must not be closed (see above)
-  ~Impl() {
-    if (jack && registered) static_cast<void>(in.release());
-  }
 };
 
 MidiInput::MidiInput(const std::string& api) : impl_(std::make_unique<Impl>()), api_(api) {
@@ -77,7 +61,6 @@ MidiInput::MidiInput(const std::string& api) : impl_(std::make_unique<Impl>()), 
     throw MidiError("MIDI API \"" + api + "\" is not available in this build");
   try {
     const QuietStderr quiet;
-    impl_->jack = id == RtMidi::UNIX_JACK;
     impl_->in = std::make_unique<RtMidiIn>(id, "hamiltone");
     impl_->in->ignoreTypes(true, true, true);  // sysex, clock/timing, active sensing
   } catch (const RtMidiError& e) {
@@ -107,7 +90,7 @@ void MidiInput::openPort(int port) {
     const QuietStderr quiet;
     impl_->in->setCallback(&MidiInput::arrived, this);
     impl_->in->openPort(static_cast<unsigned>(port), "hamiltone-in");
-    impl_->open = impl_->registered = true;
+    impl_->open = true;
     portName_ = names[static_cast<size_t>(port)];
   } catch (const RtMidiError& e) {
     throw MidiError("cannot open MIDI port " + std::to_string(port) + ": " + e.getMessage());
@@ -119,7 +102,7 @@ void MidiInput::openVirtualPort(const std::string& name) {
     const QuietStderr quiet;
     impl_->in->setCallback(&MidiInput::arrived, this);
     impl_->in->openVirtualPort(name);
-    impl_->open = impl_->registered = true;
+    impl_->open = true;
   } catch (const RtMidiError& e) {
     throw MidiError("cannot create the virtual MIDI port \"" + name + "\": " + e.getMessage());
   }
@@ -156,7 +139,7 @@ void MidiInput::close() {
   if (!impl_->in || !impl_->open) return;
   const QuietStderr quiet;
   try {
-    if (!impl_->jack) impl_->in->closePort();  // on JACK the port stays (see Impl)
+    impl_->in->closePort();
     impl_->in->cancelCallback();
   } catch (const RtMidiError&) {
   }
