@@ -695,13 +695,14 @@ TEST(PresetParameters, PrintedTableKeepsEveryCellUnderItsHeading) {
       return l.rfind(start, 0) == 0 && l != *header;  // the parameter "name" is a heading too
     });
     ASSERT_NE(row, lines.end()) << p.name;
-    std::string last = from(*row, model);
-    if (last.empty()) {  // the row goes on below
-      ASSERT_NE(row + 1, lines.end()) << p.name;
-      EXPECT_GT(row[1].find_first_not_of(' '), start.size()) << p.name << ": " << row[1];
-      last = from(row[1], model);
-      ++continued;
-    }
+    // A row goes on below when the next line starts past the name's column (a parameter's text
+    // starts at 6); its models are on its last line.
+    auto line = row;
+    while (line + 1 != lines.end() && !line[1].empty() &&
+           line[1].find_first_not_of(' ') > start.size())
+      ++line;
+    continued += line != row;
+    const std::string last = from(*line, model);
     EXPECT_TRUE(last.rfind("both", 0) == 0 || last.rfind("string", 0) == 0 ||
                 last.rfind("plate", 0) == 0)
         << p.name << ": the models start at column " << model << " of \"" << *row << "\", got \""
