@@ -652,36 +652,38 @@ TEST(PresetParameters, PerKeyParametersAreStringNumbers) {
     }
 }
 
-TEST(PresetParameters, PrintedTableListsEveryParameterIn100Columns) {
-  const std::string table = parameterTable();
-  for (const Parameter& p : parameters()) EXPECT_THAT(table, HasSubstr(std::string(p.name)));
-  size_t start = 0;
-  while (start < table.size()) {
-    const size_t end = table.find('\n', start);
-    const std::string line = table.substr(start, end - start);
-    size_t columns = 0;
-    for (unsigned char c : line) columns += (c & 0xC0) != 0x80;
-    EXPECT_LE(columns, 100u) << line;
-    start = end == std::string::npos ? table.size() : end + 1;
-  }
-}
-
-// Every row's last cell, the models it applies to, starts under the heading "model", on the row's
-// own line or, when a cell before it is wider than its column (a range such as
-// "0.01 … longitudinal_t60_low_s"), on the line that continues the row.
-TEST(PresetParameters, PrintedTableKeepsEveryCellUnderItsHeading) {
-  const std::string table = parameterTable();
+// The printed table's lines, and where a column starts in one of them (the ranges hold "…": a
+// column is a character, not a byte).
+std::vector<std::string> tableLines(const std::string& table) {
   std::vector<std::string> lines;
   for (size_t start = 0; start < table.size();) {
     const size_t end = std::min(table.find('\n', start), table.size());
     lines.push_back(table.substr(start, end - start));
     start = end + 1;
   }
-  // The text of a line from a column on (columns, not bytes: the ranges hold "…").
+  return lines;
+}
+bool continuationByte(char c) { return (static_cast<unsigned char>(c) & 0xC0) == 0x80; }
+
+TEST(PresetParameters, PrintedTableListsEveryParameterIn100Columns) {
+  const std::string table = parameterTable();
+  for (const Parameter& p : parameters()) EXPECT_THAT(table, HasSubstr(std::string(p.name)));
+  for (const std::string& line : tableLines(table))
+    EXPECT_LE(std::count_if(line.begin(), line.end(), [](char c) { return !continuationByte(c); }),
+              100)
+        << line;
+}
+
+// Every row's last cell, the models it applies to, starts under the heading "model", on the row's
+// own line or, when a cell before it is wider than its column (a range such as
+// "0.01 … longitudinal_t60_low_s"), on the line that continues the row.
+TEST(PresetParameters, PrintedTableKeepsEveryCellUnderItsHeading) {
+  const std::vector<std::string> lines = tableLines(parameterTable());
+  // The text of a line from a column on.
   auto from = [](const std::string& line, size_t column) {
     size_t at = 0, i = 0;
-    for (; i < line.size() && at < column; ++i) at += (line[i] & 0xC0) != 0x80 ? 1 : 0;
-    while (i < line.size() && (line[i] & 0xC0) == 0x80) ++i;
+    for (; i < line.size() && at < column; ++i) at += continuationByte(line[i]) ? 0 : 1;
+    while (i < line.size() && continuationByte(line[i])) ++i;
     return at == column ? line.substr(i) : std::string();
   };
   const auto header = std::find_if(lines.begin(), lines.end(),

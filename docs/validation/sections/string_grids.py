@@ -52,15 +52,21 @@ def first_spectrum(x):
     return np.fft.rfftfreq(4 * n, 1 / RATE), np.abs(np.fft.rfft(x[:n] * blackman_harris(n), 4 * n))
 
 
-def between_share(f, power, partials):
-    """The share of `power` over 0–20 kHz outside ±BAND of every frequency in `partials`, and the
-    share of 0–20 kHz those bands leave free."""
+def outside_bands(f, partials):
+    """The frequencies of 0–20 kHz outside ±BAND of every frequency in `partials`, and all of
+    0–20 kHz."""
     audible = (f > 0) & (f <= TOP_HZ)
     near = np.zeros(len(f), dtype=bool)
     for fm in partials:
         lo, hi = np.searchsorted(f, [fm - BAND, fm + BAND])
         near[lo:hi] = True
-    free = audible & ~near
+    return audible & ~near, audible
+
+
+def between_share(f, power, partials):
+    """The share of `power` over 0–20 kHz outside ±BAND of every frequency in `partials`, and the
+    share of 0–20 kHz those bands leave free."""
+    free, audible = outside_bands(f, partials)
     return float(np.sum(power[free]) / np.sum(power[audible])), free.sum() / audible.sum()
 
 
@@ -82,18 +88,14 @@ def largest_differences(g, ref, partials_g, partials_ref, count=2):
     """The frequency regions where the two-grid's and the reference's between-partials energy
     (each outside its own partials' bands, in dB re its own total) differ most in power: a list of
     (from kHz, to kHz, two-grid dB, reference dB), the largest first."""
+    runs = []
+    for run, partials in ((g, partials_g), (ref, partials_ref)):
+        free, audible = outside_bands(run["f"], partials)
+        power = run["mag"] ** 2
+        runs.append((run["f"], power * free / np.sum(power[audible])))  # shares, 0 in the bands
     found = []
     for lo, hi in zip(REGIONS_KHZ[:-1], REGIONS_KHZ[1:]):
-        shares = []
-        for run, partials in ((g, partials_g), (ref, partials_ref)):
-            f, power = run["f"], run["mag"] ** 2
-            audible = (f > 0) & (f <= TOP_HZ)
-            region = (f > 1000 * lo) & (f <= 1000 * hi)
-            near = np.zeros(len(f), dtype=bool)
-            for fm in partials:
-                a, b = np.searchsorted(f, [fm - BAND, fm + BAND])
-                near[a:b] = True
-            shares.append(float(np.sum(power[audible & region & ~near]) / np.sum(power[audible])))
+        shares = [float(np.sum(share[(f > 1000 * lo) & (f <= 1000 * hi)])) for f, share in runs]
         found.append((abs(shares[0] - shares[1]), lo, hi,
                       *(10 * math.log10(x) if x > 0 else -math.inf for x in shares)))
     found.sort(reverse=True)
