@@ -1,5 +1,5 @@
-// MidiInput on RtMidi 5: the port, the arrival callback (on RtMidi's own thread) that keeps only
-// channel voice messages, and errors that name the ports there are.
+// MidiInput: the port on RtMidi 5 (ALSA) or on a libjack client of our own (JACK), the arrival
+// callbacks that keep only channel voice messages, and errors that name the ports there are.
 #include "midi_input.h"
 
 #include <RtMidi.h>
@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 
+#include "jack_midi_input.h"
 #include "quiet_stderr.h"
 
 namespace hamiltone::app {
@@ -50,12 +51,24 @@ std::string stablePortName(const std::string& name) {
 }
 
 struct MidiInput::Impl {
+  // ALSA (and PulseAudio, which has no MIDI of its own): RtMidi.
   std::unique_ptr<RtMidiIn> in;
   std::unique_ptr<RtMidiIn> watcher;  // lists the ports while `in` has one open
-  bool open = false;                  // a port and the callback are set
+  // JACK: a client of our own, made when first needed (none while no server answers).
+  std::unique_ptr<JackMidiInput> jack;
+  bool open = false;  // a port and the callback are set
+
+  JackMidiInput& jackClient() {
+    if (!jack) {
+      const QuietStderr quiet;  // libjack's own lines on a server that is not there
+      jack = std::make_unique<JackMidiInput>("hamiltone");
+    }
+    return *jack;
+  }
 };
 
 MidiInput::MidiInput(const std::string& api) : impl_(std::make_unique<Impl>()), api_(api) {
+  if (api == "jack") return;
   const RtMidi::Api id = RtMidi::getCompiledApiByName(api == "pulse" ? "alsa" : api);
   if (id == RtMidi::UNSPECIFIED || id == RtMidi::RTMIDI_DUMMY)
     throw MidiError("MIDI API \"" + api + "\" is not available in this build");
@@ -71,6 +84,13 @@ MidiInput::MidiInput(const std::string& api) : impl_(std::make_unique<Impl>()), 
 MidiInput::~MidiInput() { close(); }
 
 std::vector<std::string> MidiInput::ports() {
+  if (api_ == "jack") {
+    try {
+      return impl_->jackClient().sources();
+    } catch (const MidiError&) {
+      return {};  // no server
+    }
+  }
   std::vector<std::string> names;
   const QuietStderr quiet;
   try {
@@ -86,42 +106,57 @@ void MidiInput::openPort(int port) {
   if (port < 0 || port >= static_cast<int>(names.size()))
     throw MidiError("--midi-port " + std::to_string(port) +
                     ": no such MIDI input port; ports: " + portList(names));
-  try {
-    const QuietStderr quiet;
-    impl_->in->setCallback(&MidiInput::arrived, this);
-    impl_->in->openPort(static_cast<unsigned>(port), "hamiltone-in");
-    impl_->open = true;
-    portName_ = names[static_cast<size_t>(port)];
-  } catch (const RtMidiError& e) {
-    throw MidiError("cannot open MIDI port " + std::to_string(port) + ": " + e.getMessage());
+  const std::string& name = names[static_cast<size_t>(port)];
+  if (api_ == "jack") {
+    impl_->jackClient().open("hamiltone-in", name, &MidiInput::arrivedOnJack, this);
+  } else {
+    try {
+      const QuietStderr quiet;
+      impl_->in->setCallback(&MidiInput::arrived, this);
+      impl_->in->openPort(static_cast<unsigned>(port), "hamiltone-in");
+    } catch (const RtMidiError& e) {
+      throw MidiError("cannot open MIDI port " + std::to_string(port) + ": " + e.getMessage());
+    }
   }
+  impl_->open = true;
+  portName_ = name;
 }
 
 void MidiInput::openVirtualPort(const std::string& name) {
-  try {
-    const QuietStderr quiet;
-    impl_->in->setCallback(&MidiInput::arrived, this);
-    impl_->in->openVirtualPort(name);
-    impl_->open = true;
-  } catch (const RtMidiError& e) {
-    throw MidiError("cannot create the virtual MIDI port \"" + name + "\": " + e.getMessage());
+  if (api_ == "jack") {
+    impl_->jackClient().open(name, "", &MidiInput::arrivedOnJack, this);
+  } else {
+    try {
+      const QuietStderr quiet;
+      impl_->in->setCallback(&MidiInput::arrived, this);
+      impl_->in->openVirtualPort(name);
+    } catch (const RtMidiError& e) {
+      throw MidiError("cannot create the virtual MIDI port \"" + name + "\": " + e.getMessage());
+    }
   }
+  impl_->open = true;
 }
 
 bool MidiInput::portPresent() {
   if (portName_.empty()) return true;
-  const QuietStderr quiet;
-  try {
-    if (!impl_->watcher)
-      impl_->watcher = std::make_unique<RtMidiIn>(
-          RtMidi::getCompiledApiByName(api_ == "pulse" ? "alsa" : api_), "hamiltone-watch");
-    const unsigned count = impl_->watcher->getPortCount();
-    for (unsigned i = 0; i < count; ++i)
-      if (stablePortName(impl_->watcher->getPortName(i)) == stablePortName(portName_)) return true;
-  } catch (const RtMidiError&) {
-    return true;  // cannot tell
+  std::vector<std::string> names;
+  if (api_ == "jack") {
+    names = ports();
+  } else {
+    const QuietStderr quiet;
+    try {
+      if (!impl_->watcher)
+        impl_->watcher = std::make_unique<RtMidiIn>(
+            RtMidi::getCompiledApiByName(api_ == "pulse" ? "alsa" : api_), "hamiltone-watch");
+      const unsigned count = impl_->watcher->getPortCount();
+      for (unsigned i = 0; i < count; ++i) names.push_back(impl_->watcher->getPortName(i));
+    } catch (const RtMidiError&) {
+      return true;  // cannot tell
+    }
   }
-  return false;
+  return std::any_of(names.begin(), names.end(), [&](const std::string& n) {
+    return stablePortName(n) == stablePortName(portName_);
+  });
 }
 
 void MidiInput::reconnect() {
@@ -131,34 +166,52 @@ void MidiInput::reconnect() {
     return stablePortName(n) == stablePortName(name);
   });
   if (found == names.end()) throw MidiError("MIDI input port \"" + name + "\" is not there");
+  if (api_ == "jack" && impl_->jack && impl_->jack->isOpen()) {
+    // The port stays registered; only the connection, which went with the keyboard, is made again.
+    impl_->jack->connect(*found);
+    portName_ = *found;
+    return;
+  }
   close();
   openPort(static_cast<int>(found - names.begin()));
 }
 
 void MidiInput::close() {
-  if (!impl_->in || !impl_->open) return;
+  if (!impl_->open) return;
+  impl_->open = false;
+  if (api_ == "jack") {
+    impl_->jack.reset();  // deactivated, then closed: no callback after this
+    return;
+  }
   const QuietStderr quiet;
   try {
     impl_->in->closePort();
     impl_->in->cancelCallback();
   } catch (const RtMidiError&) {
   }
-  impl_->open = false;
 }
 
-// RtMidi's thread: channel voice messages (0x80–0xEF, whole) into the queue; anything else —
-// system common, a stray data byte — is left out.
-void MidiInput::arrived(double, std::vector<unsigned char>* bytes, void* self) {
-  auto* input = static_cast<MidiInput*>(self);
-  if (bytes->empty()) return;
-  const unsigned status = (*bytes)[0];
+// Channel voice messages (0x80–0xEF, whole) into the queue; anything else — system common, a
+// stray data byte — is left out.
+void MidiInput::push(const unsigned char* bytes, size_t size, std::int64_t arrivalNs) noexcept {
+  if (size == 0) return;
+  const unsigned status = bytes[0];
   if (status < 0x80 || status > 0xEF) return;
   const size_t length = (status & 0xF0) == 0xC0 || (status & 0xF0) == 0xD0 ? 2 : 3;
-  if (bytes->size() < length) return;
-  StampedMessage m{steadyNanoseconds(),
-                   {static_cast<std::uint8_t>(status), (*bytes)[1],
-                    length == 3 ? (*bytes)[2] : std::uint8_t{0}}};
-  if (!input->queue_.push(m)) input->dropped_.fetch_add(1, std::memory_order_relaxed);
+  if (size < length) return;
+  const StampedMessage m{
+      arrivalNs,
+      {static_cast<std::uint8_t>(status), bytes[1], length == 3 ? bytes[2] : std::uint8_t{0}}};
+  if (!queue_.push(m)) dropped_.fetch_add(1, std::memory_order_relaxed);
+}
+
+void MidiInput::arrived(double, std::vector<unsigned char>* bytes, void* self) {
+  static_cast<MidiInput*>(self)->push(bytes->data(), bytes->size(), steadyNanoseconds());
+}
+
+void MidiInput::arrivedOnJack(const unsigned char* bytes, size_t size, std::int64_t arrivalNs,
+                              void* self) noexcept {
+  static_cast<MidiInput*>(self)->push(bytes, size, arrivalNs);
 }
 
 }  // namespace hamiltone::app

@@ -1,6 +1,7 @@
-// MIDI input on RtMidi 5: a real port or a virtual one the player creates. Each channel message is
-// timestamped on arrival and copied into a lock-free queue that the audio thread drains; sysex,
-// clock and active sensing are ignored (RtMidi drops them before they reach us).
+// MIDI input: a real port or a virtual one the player creates, on ALSA through RtMidi 5 and on JACK
+// through a libjack client of its own (jack_midi_input.h). Each channel message is timestamped on
+// arrival and copied into a lock-free queue that the audio thread drains; anything else — sysex,
+// clock, active sensing — is left out.
 #pragma once
 
 #include <atomic>
@@ -40,6 +41,8 @@ class MidiInput {
   static constexpr size_t kQueueSize = 4096;
 
   // api: "jack" or "alsa" (PulseAudio has no MIDI: it uses ALSA's sequencer). Throws MidiError.
+  // On JACK the client is made when first needed: without a server, ports() is empty and opening
+  // a port throws.
   explicit MidiInput(const std::string& api);
   ~MidiInput();
   std::vector<std::string> ports();
@@ -59,7 +62,10 @@ class MidiInput {
   long dropped() const { return dropped_.load(); }  // the queue was full
 
  private:
-  static void arrived(double, std::vector<unsigned char>* bytes, void* self);
+  static void arrived(double, std::vector<unsigned char>* bytes, void* self);  // RtMidi's thread
+  static void arrivedOnJack(const unsigned char* bytes, size_t size, std::int64_t arrivalNs,
+                            void* self) noexcept;  // JACK's process thread
+  void push(const unsigned char* bytes, size_t size, std::int64_t arrivalNs) noexcept;
 
   struct Impl;
   std::unique_ptr<Impl> impl_;

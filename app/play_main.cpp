@@ -341,11 +341,9 @@ int play(const PlayArguments& a) {
                  recordingFailureShown ? "  REC STOPPED" : "");
     std::fflush(stderr);
   }
-  // The MIDI input first: on JACK its port is unregistered while the graph is otherwise still.
-  // Unregistered right after the audio client's deactivation, the port's list node can be freed
-  // while libjack's notification thread walks that list for the latency recompute the
-  // deactivation set off (jackd2 1.9.21): the player once crashed so, at this line, and lost its
-  // recording.
+  // The MIDI input first, while the graph is otherwise still: on JACK its client is deactivated and
+  // then closed (jack_midi_input.h). RtMidi's input, which unregistered its port on an active
+  // client, crashed the player here once, in libjack's latency recompute, and lost its recording.
   midi.close();
   audio.stop();
   const Player::Status s = player.status();

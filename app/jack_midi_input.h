@@ -1,0 +1,56 @@
+// MIDI input on a libjack client of its own: one input port, registered before the client is
+// activated and never unregistered while it is active — the client is deactivated, then closed.
+// RtMidi's JACK input unregisters its port on an active client, which raced with libjack's latency
+// recompute (jackd2 1.9.21) and crashed the player at its stop, losing its recording.
+#pragma once
+
+#include <jack/jack.h>
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace hamiltone::app {
+
+class JackMidiInput {
+ public:
+  // Called on JACK's process thread for each event, with its bytes and its arrival on the steady
+  // clock (ns): the event's place in the period that ends at the callback, so a period's events
+  // keep their spacing. Must not allocate, lock or block.
+  using Arrival = void (*)(const unsigned char* bytes, size_t size, std::int64_t arrivalNs,
+                           void* user);
+
+  // A client named `clientName` (JACK appends a number when the name is taken) on the running
+  // server; throws MidiError when there is none. The client stays inactive until a port opens.
+  explicit JackMidiInput(const std::string& clientName);
+  ~JackMidiInput();
+  JackMidiInput(const JackMidiInput&) = delete;
+  JackMidiInput& operator=(const JackMidiInput&) = delete;
+
+  // The MIDI output ports of the server's clients ("client:port"); none once the server is gone.
+  std::vector<std::string> sources() const;
+  // Registers the input port `portName`, activates the client and connects `source` to the port
+  // (none: a port for others to connect to). Throws MidiError naming the port.
+  void open(const std::string& portName, const std::string& source, Arrival arrival, void* user);
+  // Connects `source` to the open port again (a keyboard that came back). Throws MidiError.
+  void connect(const std::string& source);
+  // Deactivates the client, then closes it: no callback runs after this returns.
+  void close() noexcept;
+  bool isOpen() const { return port_ != nullptr; }
+
+ private:
+  static int process(jack_nframes_t frames, void* self);
+  static void serverGone(void* self);
+
+  jack_client_t* client_ = nullptr;
+  jack_port_t* port_ = nullptr;
+  Arrival arrival_ = nullptr;
+  void* user_ = nullptr;
+  double nsPerFrame_ = 0.0;
+  std::int64_t lastArrivalNs_ = 0;  // the process thread's: arrivals never go back
+  std::atomic<bool> gone_{false};   // the server shut the client down
+};
+
+}  // namespace hamiltone::app
