@@ -181,15 +181,7 @@ class SavScheme {
   // vectorised (`omp simd`, with -fopenmp-simd): a fixed, deterministic summation order.
   template <bool lossy>
   void stepInternal() noexcept {
-    const double k = params_.k;
-    const double up = 1.0 + params_.sigma0 * k;
-    const double down = 1.0 - params_.sigma0 * k;
-    const double kk = k * k;
-    const Eigen::Index n = system_.size();
-    const double* minv = system_.inverseMass().data();
-    const double* qm = prev_.data();
-    const double* q = curr_.data();
-    double* qp = next_.data();
+    const auto [k, up, down, kk, n, minv, qm, q, qp] = view();
     const double* kq = kq_.data();
 
     // (39): g_j = ∇V'_j / sqrt(2 (V'_j + ε)), g_j = 0 where V'_j + ε = 0; grads_ hold ∇V'_j, so
@@ -228,6 +220,11 @@ class SavScheme {
         extra_ = (2.0 * params_.sigma1 * k) * lossForce;
         cq = extra_.data();
       }
+    }
+
+    if (onePass && !damped_) {
+      stepOnePart<lossy>(onlyLoaded, s[onlyLoaded], h[onlyLoaded], cq, cqScale, g[onlyLoaded]);
+      return;
     }
 
     // Pass 1: ∇V'_jᵀ of q^n, q^{n−1}, M⁻¹K q^n, M⁻¹C(q^n − q^{n−1}), and ∇V'_iᵀ M⁻¹ ∇V'_j.
@@ -354,15 +351,75 @@ class SavScheme {
     for (int p = 0; p < kPointForces; ++p)
       supplied_ += 0.5 * pointForce_[p] * (qp[pointIndex_[p]] - qm[pointIndex_[p]]);
     for (int a = 0; a < parts; ++a) psi_[a] += 0.5 * s[a] * gdq[a];  // (38c)
+    finishStep<lossy>();
+  }
+
+  // The step's constants and its three levels: q^{n−1}, q^n and q^{n+1} being written.
+  struct StepView {
+    double k, up, down, kk;  // k, 1 + σ0k, 1 − σ0k, k²
+    Eigen::Index n;
+    const double* minv;
+    const double* qm;
+    const double* q;
+    double* qp;
+  };
+  StepView view() noexcept {
+    const double k = params_.k;
+    return {k,
+            1.0 + params_.sigma0 * k,
+            1.0 - params_.sigma0 * k,
+            k * k,
+            system_.size(),
+            system_.inverseMass().data(),
+            prev_.data(),
+            curr_.data(),
+            next_.data()};
+  }
+
+  // After q^{n+1}: the loss's share (50) and the force's work, then the levels move on.
+  template <bool lossy>
+  void finishStep() noexcept {
     if constexpr (lossy) {
       if (params_.trackDissipation)
         dissipated_ += loss_.dissipation(system_, next_, prev_);  // (50)
       if (forced_) supplied_ += 0.5 * force_.dot(next_ - prev_);  // the work of f over the step
     }
-
     prev_.swap(curr_);
     curr_.swap(next_);
     ++n_;
+  }
+
+  // The step with one part loaded and no damper — a string off its hammer, nearly every step: the
+  // Woodbury solve of stepInternal is then one division, y = vᵀb / ((1+σ0k) + vᵀu), and the slack
+  // parts, whose ∇V'_j is zero, add nothing (their ψ_j stays as it is).
+  template <bool lossy>
+  void stepOnePart(int a, double s, double h, const double* cq, double cqScale,
+                   const double* g) noexcept {
+    const auto [k, up, down, kk, n, minv, qm, q, qp] = view();
+    const double* kq = splitK ? kq_.data() : nullptr;
+    double dots[5];  // gᵀq, gᵀqm, gᵀM⁻¹Kq, gᵀM⁻¹(extra), gᵀM⁻¹g
+    kernels_->savDots(n, g, q, qm, minv, kq, lossy ? cq : nullptr, cqScale, dots);
+    double gMCq = dots[3];
+    for (int p = 0; p < kPointForces; ++p)
+      gMCq -= kk * g[pointIndex_[p]] * minv[pointIndex_[p]] * pointForce_[p];
+    const double bLinear = h * dots[1] - 2.0 * k * psi_[a];  // βᵀq^{n−1} − 2kψ
+    const double vtu = h * h * dots[4];
+    const double vtb =
+        h * (2.0 * dots[0] - down * dots[1] - kk * dots[2] - gMCq + bLinear * h * dots[4]);
+    const double y = vtb / (up + vtu);  // (33)
+    const double invUp = 1.0 / up;
+    double gdq = kernels_->savUpdate(n, g, q, qm, minv, kq, lossy ? cq : nullptr, cqScale, down, kk,
+                                     h * (bLinear - y), invUp, qp);
+    for (int p = 0; p < kPointForces; ++p) {
+      const Eigen::Index i = pointIndex_[p];
+      const double dx = kk * minv[i] * pointForce_[p] * invUp;
+      qp[i] += dx;
+      gdq += g[i] * dx;
+    }
+    for (int p = 0; p < kPointForces; ++p)
+      supplied_ += 0.5 * pointForce_[p] * (qp[pointIndex_[p]] - qm[pointIndex_[p]]);
+    psi_[a] += 0.5 * s * gdq;  // (38c)
+    finishStep<lossy>();
   }
 
   // (44): k <= 2 / sqrt(λmax(M^-½ K M^-½)), else the energy (41) has no sign and no bound;
