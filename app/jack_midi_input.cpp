@@ -6,8 +6,10 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <thread>
 
 #include "midi_input.h"
 
@@ -26,14 +28,16 @@ std::string hex(unsigned value) {
 JackMidiInput::JackMidiInput(const std::string& clientName) {
   jack_status_t status{};
   client_ = jack_client_open(clientName.c_str(), JackNoStartServer, &status);
+  if (!client_ && (status & JackServerFailed))
+    throw MidiError(
+        "MIDI input on jack: no JACK server answers; start one (jackd, or qjackctl) "
+        "or choose --api alsa");
   if (!client_)
-    throw MidiError("MIDI input on jack: no JACK server answers (jack_client_open status " +
-                    hex(static_cast<unsigned>(status)) +
-                    "); start one (jackd, or qjackctl) or choose --api alsa");
+    throw MidiError("MIDI input on jack: the server refused the client \"" + clientName +
+                    "\" (jack_client_open status " + hex(static_cast<unsigned>(status)) + ")");
   // Both before activation, as libjack asks.
   jack_set_process_callback(client_, &JackMidiInput::process, this);
   jack_on_shutdown(client_, &JackMidiInput::serverGone, this);
-  nsPerFrame_ = 1e9 / jack_get_sample_rate(client_);
 }
 
 JackMidiInput::~JackMidiInput() { close(); }
@@ -58,9 +62,8 @@ void JackMidiInput::open(const std::string& portName, const std::string& source,
     throw MidiError("cannot register the JACK MIDI port \"" + portName +
                     "\" (a port of that name exists, or the name is too long)");
   if (jack_activate(client_) != 0) {
-    // Not active yet, so the port may go now without a latency recompute to race with.
-    jack_port_unregister(client_, port_);
-    port_ = nullptr;
+    // libjack may take the client for active already: the port goes with the whole client.
+    close();
     throw MidiError("cannot activate the JACK client of MIDI port \"" + portName + "\"");
   }
   if (!source.empty()) connect(source);
@@ -76,9 +79,14 @@ void JackMidiInput::connect(const std::string& source) {
 
 void JackMidiInput::close() noexcept {
   if (!client_) return;
-  // Deactivated first: the server then leaves the client out of the graph before its port goes
-  // with it, and calls none of its callbacks again.
-  if (port_ && !gone_.load()) jack_deactivate(client_);
+  if (port_ && !gone_.load()) {
+    closing_.store(true);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(250);
+    while (returnedClosing_.load() == 0 && std::chrono::steady_clock::now() < deadline)
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    // Deactivated before it is closed: the port never leaves an active client.
+    jack_deactivate(client_);
+  }
   jack_client_close(client_);
   client_ = nullptr;
   port_ = nullptr;
@@ -86,17 +94,22 @@ void JackMidiInput::close() noexcept {
 
 int JackMidiInput::process(jack_nframes_t frames, void* self) {
   auto* in = static_cast<JackMidiInput*>(self);
+  if (in->closing_.load()) {
+    in->returnedClosing_.fetch_add(1);
+    return 0;
+  }
   void* buffer = jack_port_get_buffer(in->port_, frames);
   const jack_nframes_t count = jack_midi_get_event_count(buffer);
   if (count == 0) return 0;
-  // The period this callback reads ended now: an event at frame t of it arrived (frames − t)
-  // frames ago.
+  // An event at frame t of this period is stamped t frames after now. The player's callback, in
+  // this cycle or the next, then places the period's events one period later at their spacing.
   const std::int64_t now = steadyNanoseconds();
+  const double nsPerFrame = 1e9 / jack_get_sample_rate(in->client_);
   for (jack_nframes_t i = 0; i < count; ++i) {
     jack_midi_event_t event;
     if (jack_midi_event_get(&event, buffer, i) != 0) continue;
-    const double ago = static_cast<double>(frames - std::min(event.time, frames)) * in->nsPerFrame_;
-    const std::int64_t at = std::max<std::int64_t>(now - std::llround(ago), in->lastArrivalNs_);
+    const double after = static_cast<double>(std::min(event.time, frames)) * nsPerFrame;
+    const std::int64_t at = std::max<std::int64_t>(now + std::llround(after), in->lastArrivalNs_);
     in->lastArrivalNs_ = at;
     in->arrival_(event.buffer, event.size, at, in->user_);
   }

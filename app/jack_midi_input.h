@@ -16,14 +16,16 @@ namespace hamiltone::app {
 
 class JackMidiInput {
  public:
-  // Called on JACK's process thread for each event, with its bytes and its arrival on the steady
-  // clock (ns): the event's place in the period that ends at the callback, so a period's events
-  // keep their spacing. Must not allocate, lock or block.
+  // Called on JACK's process thread for each event, with its bytes and its time on the steady
+  // clock (ns): the callback's time plus the event's frame in the period, so that a period's events
+  // keep their spacing and the player plays them one period later whichever of its client and ours
+  // the server runs first (app/player.h). Must not allocate, lock or block.
   using Arrival = void (*)(const unsigned char* bytes, size_t size, std::int64_t arrivalNs,
                            void* user);
 
-  // A client named `clientName` (JACK appends a number when the name is taken) on the running
-  // server; throws MidiError when there is none. The client stays inactive until a port opens.
+  // A client named `clientName` (JACK appends a number when the name is taken: make it before the
+  // audio client of the same name) on the running server; throws MidiError when there is none.
+  // The client stays inactive until a port opens.
   explicit JackMidiInput(const std::string& clientName);
   ~JackMidiInput();
   JackMidiInput(const JackMidiInput&) = delete;
@@ -32,11 +34,15 @@ class JackMidiInput {
   // The MIDI output ports of the server's clients ("client:port"); none once the server is gone.
   std::vector<std::string> sources() const;
   // Registers the input port `portName`, activates the client and connects `source` to the port
-  // (none: a port for others to connect to). Throws MidiError naming the port.
+  // (none: a port for others to connect to). Throws MidiError naming the port; a client that
+  // could not be activated is closed.
   void open(const std::string& portName, const std::string& source, Arrival arrival, void* user);
   // Connects `source` to the open port again (a keyboard that came back). Throws MidiError.
   void connect(const std::string& source);
-  // Deactivates the client, then closes it: no callback runs after this returns.
+  // Deactivates the client, then closes it: no callback runs after this returns. jackd2 cancels
+  // the process thread on deactivation, so a callback must not be inside ours then (cancelled in a
+  // noexcept function the program would terminate): the callbacks are first told to return at once,
+  // and one that has is waited for (250 ms at most: a server that stopped calling).
   void close() noexcept;
   bool isOpen() const { return port_ != nullptr; }
 
@@ -48,9 +54,10 @@ class JackMidiInput {
   jack_port_t* port_ = nullptr;
   Arrival arrival_ = nullptr;
   void* user_ = nullptr;
-  double nsPerFrame_ = 0.0;
   std::int64_t lastArrivalNs_ = 0;  // the process thread's: arrivals never go back
   std::atomic<bool> gone_{false};   // the server shut the client down
+  std::atomic<bool> closing_{false};
+  std::atomic<int> returnedClosing_{0};  // callbacks that returned at once, closing_ set
 };
 
 }  // namespace hamiltone::app

@@ -54,7 +54,9 @@ struct MidiInput::Impl {
   // ALSA (and PulseAudio, which has no MIDI of its own): RtMidi.
   std::unique_ptr<RtMidiIn> in;
   std::unique_ptr<RtMidiIn> watcher;  // lists the ports while `in` has one open
-  // JACK: a client of our own, made when first needed (none while no server answers).
+  // JACK: a client of our own, made at once — before the audio client, which takes the name
+  // "hamiltone" too, so that our ports keep it: "hamiltone:hamiltone-in" — or when first needed
+  // (none while no server answers).
   std::unique_ptr<JackMidiInput> jack;
   bool open = false;  // a port and the callback are set
 
@@ -68,7 +70,13 @@ struct MidiInput::Impl {
 };
 
 MidiInput::MidiInput(const std::string& api) : impl_(std::make_unique<Impl>()), api_(api) {
-  if (api == "jack") return;
+  if (api == "jack") {
+    try {
+      impl_->jackClient();
+    } catch (const MidiError&) {  // no server yet: ports() is empty, opening a port says why
+    }
+    return;
+  }
   const RtMidi::Api id = RtMidi::getCompiledApiByName(api == "pulse" ? "alsa" : api);
   if (id == RtMidi::UNSPECIFIED || id == RtMidi::RTMIDI_DUMMY)
     throw MidiError("MIDI API \"" + api + "\" is not available in this build");
@@ -177,12 +185,15 @@ void MidiInput::reconnect() {
 }
 
 void MidiInput::close() {
-  if (!impl_->open) return;
-  impl_->open = false;
   if (api_ == "jack") {
-    impl_->jack.reset();  // deactivated, then closed: no callback after this
+    // Whether or not a port opened (connecting it may have failed on an active client):
+    // deactivated, then closed, and no callback after this, before the queue it fills goes.
+    impl_->jack.reset();
+    impl_->open = false;
     return;
   }
+  if (!impl_->open) return;
+  impl_->open = false;
   const QuietStderr quiet;
   try {
     impl_->in->closePort();

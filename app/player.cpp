@@ -61,11 +61,20 @@ void Player::render(float* interleaved, int frames, std::int64_t nowNs) noexcept
   // The block stands for the buffer period that ended now: [now − P, now).
   const double period = frames / sampleRate_;
   int count = 0;
+  const bool mayWait = !waited_;
+  waited_ = false;
   while (count < kMaxEventsPerBlock) {
     const StampedMessage* m = midi_.peek();
     if (!m) break;
     const double age = static_cast<double>(nowNs - m->arrivalNs) * 1e-9;
     const long offset = std::lround((period - age) * sampleRate_);
+    // Stamped within the next period (the JACK input stamps a period's events ahead of its own
+    // callback, which may run before ours): left for the next block, where it lands in place —
+    // for one block only, so that a clock that does not move cannot hold it for good.
+    if (mayWait && offset >= frames && offset < 2L * frames) {
+      waited_ = true;
+      break;
+    }
     events_[count++] = {static_cast<int>(std::clamp(offset, 0L, frames - 1L)), m->message};
     last_.store(std::uint32_t{m->message.status} << 16 | m->message.data1 << 8 | m->message.data2,
                 std::memory_order_relaxed);

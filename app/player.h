@@ -48,7 +48,9 @@ class Player {
 
   // Fills `frames` interleaved stereo frames. A message that arrived a time d before `nowNs`
   // lands d·rate samples before the end of this block: a constant latency of one buffer, and
-  // the spacing of the messages kept to the sample.
+  // the spacing of the messages kept to the sample. One stamped up to a period after `nowNs` is
+  // left for the next block (once), where it lands in place; earlier or later ones are clamped to
+  // this block.
   void render(float* interleaved, int frames, std::int64_t nowNs) noexcept HAMILTONE_NONBLOCKING;
 
   struct Status {
@@ -88,6 +90,7 @@ class Player {
   std::vector<SynthEvent> events_, scored_, merged_;
   std::vector<ScoreEvent> score_;
   size_t nextScored_ = 0;
+  bool waited_ = false;    // the last render() left messages for the next block
   bool hasScore_ = false;  // setScore() was called, even with an empty score
   bool endRecording_ = false, recordingEnded_ = false;
   std::int64_t position_ = 0;  // samples rendered

@@ -96,9 +96,12 @@ TEST(Player, NoteLandsWhereItsArrivalTimePutsIt) {
   ASSERT_GE(delay, 0);
   ASSERT_LT(delay, kFrames);
 
-  for (const auto& [age, offset] : {std::pair{1.0, kFrames - 1}, std::pair{100.0, kFrames - 100},
-                                    std::pair{255.0, 1}, std::pair{256.0, 0}, std::pair{700.0, 0},
-                                    std::pair{-50.0, kFrames - 1}, std::pair{0.0, kFrames - 1}}) {
+  // Stamped up to a period ahead (age −50 or 0), it lands in the next block in place; further
+  // ahead, at the end of this one.
+  for (const auto& [age, offset] :
+       {std::pair{1.0, kFrames - 1}, std::pair{100.0, kFrames - 100}, std::pair{255.0, 1},
+        std::pair{256.0, 0}, std::pair{700.0, 0}, std::pair{-50.0, kFrames + 50},
+        std::pair{0.0, kFrames}, std::pair{-300.0, kFrames - 1}}) {
     SCOPED_TRACE(::testing::Message() << "arrived " << age << " samples before now");
     Synth synth = prepared({pianoKeys(60, 60)});
     SpscQueue<StampedMessage> midi(16);
@@ -113,8 +116,9 @@ TEST(Player, NoteLandsWhereItsArrivalTimePutsIt) {
   }
 }
 
-// Messages in arrival order keep their spacing to the sample: the block equals the synth's own
-// output with each event at frames − d·rate (non-decreasing, clamped to the block).
+// Messages in arrival order keep their spacing to the sample: two blocks equal the synth's own
+// output with each event at frames − d·rate (non-decreasing, clamped to the first block), those
+// stamped ahead of now (the JACK input's, jack_midi_input.h) in the second block.
 TEST(Player, MessagesInArrivalOrderKeepTheirSpacing) {
   constexpr int kFrames = 512;
   const std::pair<double, MidiMessage> arrivals[] = {
@@ -122,21 +126,26 @@ TEST(Player, MessagesInArrivalOrderKeepTheirSpacing) {
       {300.0, {0x90, 52, 127}}, {299.0, {0x80, 48, 0}},   {120.0, {0xE0, 0, 90}},
       {40.0, {0x90, 49, 100}},  {-10.0, {0x90, 51, 100}}, {-30.0, {0xB0, 7, 80}}};
   Synth reference = prepared({pianoKeys(48, 52)});
-  std::vector<SynthEvent> events;
-  for (const auto& [age, message] : arrivals)
-    events.push_back({std::clamp(kFrames - static_cast<int>(age), 0, kFrames - 1), message});
-  ASSERT_TRUE(std::is_sorted(events.begin(), events.end(),
-                             [](const auto& a, const auto& b) { return a.offset < b.offset; }));
-  std::vector<float> l(kFrames), r(kFrames);
-  reference.process(l, r, events);
+  std::vector<SynthEvent> first, second;
+  for (const auto& [age, message] : arrivals) {
+    if (age > 0.0)
+      first.push_back({std::clamp(kFrames - static_cast<int>(age), 0, kFrames - 1), message});
+    else
+      second.push_back({-static_cast<int>(age), message});
+  }
+  std::vector<float> l(2 * kFrames), r(2 * kFrames);
+  reference.process(std::span(l).first(kFrames), std::span(r).first(kFrames), first);
+  reference.process(std::span(l).last(kFrames), std::span(r).last(kFrames), second);
 
   Synth synth = prepared({pianoKeys(48, 52)});
   SpscQueue<StampedMessage> midi(16);
   Player player(synth, midi, nullptr, kRate, kFrames);
   for (const auto& [age, message] : arrivals) ASSERT_TRUE(midi.push({before(age), message}));
-  std::vector<float> interleaved(2 * kFrames);
+  std::vector<float> interleaved(4 * kFrames);
   player.render(interleaved.data(), kFrames, kNow);
-  for (int i = 0; i < kFrames; ++i) {
+  EXPECT_EQ(player.status().lastMessage, 0x90u << 16 | 49u << 8 | 100u);  // the rest waits
+  player.render(interleaved.data() + 2 * kFrames, kFrames, kNow + nanoseconds(kFrames / kRate));
+  for (int i = 0; i < 2 * kFrames; ++i) {
     ASSERT_EQ(interleaved[2 * i], l[i]) << "frame " << i;
     ASSERT_EQ(interleaved[2 * i + 1], r[i]) << "frame " << i;
   }

@@ -623,8 +623,15 @@ TEST_F(JackPlay, TheMidiInputClosesWhileTheGraphChanges) {
   if (!onPath("jackd") || !onPath("jack_lsp"))
     GTEST_SKIP() << "jackd (Debian's jackd2) is not installed";
   ASSERT_NO_FATAL_FAILURE(startServer(false));
-  ::setenv("JACK_DEFAULT_SERVER", server_.c_str(), 1);
-  ::setenv("JACK_NO_START_SERVER", "1", 1);
+  // This process a client of that server, as the tests' children are (restored at the end).
+  std::vector<std::pair<std::string, std::optional<std::string>>> saved;
+  for (const auto& [name, value] :
+       {std::pair<std::string, std::string>{"JACK_DEFAULT_SERVER", server_},
+        {"JACK_NO_START_SERVER", "1"}}) {
+    const char* was = std::getenv(name.c_str());
+    saved.emplace_back(name, was ? std::optional<std::string>(was) : std::nullopt);
+    ::setenv(name.c_str(), value.c_str(), 1);
+  }
   // Our port's full name, from one opening before the loop.
   std::string ours;
   {
@@ -652,14 +659,20 @@ TEST_F(JackPlay, TheMidiInputClosesWhileTheGraphChanges) {
       jack_deactivate(churn);
     }
   });
-  for (int i = 0; i < 300; ++i) {
-    hamiltone::app::MidiInput input("jack");
-    input.openVirtualPort("hamiltone-in");
-    input.close();
+  try {
+    for (int i = 0; i < 300; ++i) {
+      hamiltone::app::MidiInput input("jack");
+      input.openVirtualPort("hamiltone-in");
+      input.close();
+    }
+  } catch (const hamiltone::app::MidiError& e) {
+    ADD_FAILURE() << e.what();
   }
   stop.store(true);
   graph.join();
   jack_client_close(churn);
+  for (const auto& [name, was] : saved)
+    was ? ::setenv(name.c_str(), was->c_str(), 1) : ::unsetenv(name.c_str());
   // Closed means gone from the graph.
   EXPECT_EQ(ports().value_or("").find(":hamiltone-in"), std::string::npos);
 }
