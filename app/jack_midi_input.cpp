@@ -63,6 +63,7 @@ void JackMidiInput::open(const std::string& portName, const std::string& source,
                     "\" (a port of that name exists, or the name is too long)");
   if (jack_activate(client_) != 0) {
     // libjack may take the client for active already: the port goes with the whole client.
+    port_ = nullptr;
     close();
     throw MidiError("cannot activate the JACK client of MIDI port \"" + portName + "\"");
   }
@@ -101,17 +102,26 @@ int JackMidiInput::process(jack_nframes_t frames, void* self) {
   void* buffer = jack_port_get_buffer(in->port_, frames);
   const jack_nframes_t count = jack_midi_get_event_count(buffer);
   if (count == 0) return 0;
-  // An event at frame t of this period is stamped t frames after now. The player's callback, in
+  // An event at frame t of this period is stamped t frames after the cycle's start, on the
+  // steady clock (wherever in the cycle the server runs this client). The player's callback, in
   // this cycle or the next, then places the period's events one period later at their spacing.
-  const std::int64_t now = steadyNanoseconds();
+  std::int64_t start = steadyNanoseconds();
+  jack_nframes_t cycleFrames = 0;
+  jack_time_t cycleStart = 0, nextStart = 0;
+  float periodUs = 0.0f;
+  const jack_time_t now = jack_get_time();
+  if (jack_get_cycle_times(in->client_, &cycleFrames, &cycleStart, &nextStart, &periodUs) == 0 &&
+      now >= cycleStart && now - cycleStart < 1'000'000)
+    start -= 1000 * static_cast<std::int64_t>(now - cycleStart);
   const double nsPerFrame = 1e9 / jack_get_sample_rate(in->client_);
   for (jack_nframes_t i = 0; i < count; ++i) {
     jack_midi_event_t event;
     if (jack_midi_event_get(&event, buffer, i) != 0) continue;
     const double after = static_cast<double>(std::min(event.time, frames)) * nsPerFrame;
-    const std::int64_t at = std::max<std::int64_t>(now + std::llround(after), in->lastArrivalNs_);
-    in->lastArrivalNs_ = at;
-    in->arrival_(event.buffer, event.size, at, in->user_);
+    const std::int64_t stamp =
+        std::max<std::int64_t>(start + std::llround(after), in->lastArrivalNs_);
+    in->lastArrivalNs_ = stamp;
+    in->arrival_(event.buffer, event.size, stamp, in->user_);
   }
   return 0;
 }

@@ -17,7 +17,7 @@ namespace hamiltone::app {
 class JackMidiInput {
  public:
   // Called on JACK's process thread for each event, with its bytes and its time on the steady
-  // clock (ns): the callback's time plus the event's frame in the period, so that a period's events
+  // clock (ns): the cycle's start plus the event's frame in the period, so that a period's events
   // keep their spacing and the player plays them one period later whichever of its client and ours
   // the server runs first (app/player.h). Must not allocate, lock or block.
   using Arrival = void (*)(const unsigned char* bytes, size_t size, std::int64_t arrivalNs,

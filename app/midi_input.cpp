@@ -116,7 +116,7 @@ void MidiInput::openPort(int port) {
                     ": no such MIDI input port; ports: " + portList(names));
   const std::string& name = names[static_cast<size_t>(port)];
   if (api_ == "jack") {
-    impl_->jackClient().open("hamiltone-in", name, &MidiInput::arrivedOnJack, this);
+    openOnJack("hamiltone-in", name);
   } else {
     try {
       const QuietStderr quiet;
@@ -132,7 +132,7 @@ void MidiInput::openPort(int port) {
 
 void MidiInput::openVirtualPort(const std::string& name) {
   if (api_ == "jack") {
-    impl_->jackClient().open(name, "", &MidiInput::arrivedOnJack, this);
+    openOnJack(name, "");
   } else {
     try {
       const QuietStderr quiet;
@@ -143,6 +143,17 @@ void MidiInput::openVirtualPort(const std::string& name) {
     }
   }
   impl_->open = true;
+}
+
+// A port that failed to open takes its client along (made again when next needed): whatever
+// state it failed in, no callback is left to fill the queue.
+void MidiInput::openOnJack(const std::string& portName, const std::string& source) {
+  try {
+    impl_->jackClient().open(portName, source, &MidiInput::arrivedOnJack, this);
+  } catch (const MidiError&) {
+    impl_->jack.reset();
+    throw;
+  }
 }
 
 bool MidiInput::portPresent() {

@@ -66,6 +66,7 @@ class MidiInput {
   static void arrivedOnJack(const unsigned char* bytes, size_t size, std::int64_t arrivalNs,
                             void* self) noexcept;  // JACK's process thread
   void push(const unsigned char* bytes, size_t size, std::int64_t arrivalNs) noexcept;
+  void openOnJack(const std::string& portName, const std::string& source);
 
   struct Impl;
   std::unique_ptr<Impl> impl_;

@@ -61,8 +61,6 @@ void Player::render(float* interleaved, int frames, std::int64_t nowNs) noexcept
   // The block stands for the buffer period that ended now: [now − P, now).
   const double period = frames / sampleRate_;
   int count = 0;
-  const bool mayWait = !waited_;
-  waited_ = false;
   while (count < kMaxEventsPerBlock) {
     const StampedMessage* m = midi_.peek();
     if (!m) break;
@@ -70,9 +68,9 @@ void Player::render(float* interleaved, int frames, std::int64_t nowNs) noexcept
     const long offset = std::lround((period - age) * sampleRate_);
     // Stamped within the next period (the JACK input stamps a period's events ahead of its own
     // callback, which may run before ours): left for the next block, where it lands in place —
-    // for one block only, so that a clock that does not move cannot hold it for good.
-    if (mayWait && offset >= frames && offset < 2L * frames) {
-      waited_ = true;
+    // each message once, so that a clock that does not move cannot hold one for good.
+    if (offset >= frames && offset < 2L * frames && m->arrivalNs != heldNs_) {
+      heldNs_ = m->arrivalNs;
       break;
     }
     events_[count++] = {static_cast<int>(std::clamp(offset, 0L, frames - 1L)), m->message};

@@ -90,8 +90,8 @@ class Player {
   std::vector<SynthEvent> events_, scored_, merged_;
   std::vector<ScoreEvent> score_;
   size_t nextScored_ = 0;
-  bool waited_ = false;    // the last render() left messages for the next block
-  bool hasScore_ = false;  // setScore() was called, even with an empty score
+  std::int64_t heldNs_ = -1;  // the stamp of the message render() last left for the next block
+  bool hasScore_ = false;     // setScore() was called, even with an empty score
   bool endRecording_ = false, recordingEnded_ = false;
   std::int64_t position_ = 0;  // samples rendered
   double overload_;

@@ -152,6 +152,36 @@ TEST(Player, MessagesInArrivalOrderKeepTheirSpacing) {
   EXPECT_EQ(player.status().lastMessage, 0xB0u << 16 | 7u << 8 | 80u);
 }
 
+// Stamped ahead of now in one period after another (the JACK input's, its client run before the
+// player's each cycle): each period's message waits one block and lands in place there — a block
+// that took a waiting message still leaves the next period's for the block after.
+TEST(Player, MessagesStampedAheadEveryPeriodEachLandInTheNextBlock) {
+  constexpr int kFrames = 256, kBlocks = 4, kAhead = 10;
+  Synth reference = prepared({pianoKeys(48, 52)});
+  std::vector<float> l((kBlocks + 1) * kFrames), r(l.size());
+  for (int b = 0; b <= kBlocks; ++b) {
+    std::vector<SynthEvent> events;
+    if (b > 0) events.push_back({kAhead, {0x90, uint8_t(47 + b), 100}});
+    reference.process(std::span(l).subspan(b * kFrames, kFrames),
+                      std::span(r).subspan(b * kFrames, kFrames), events);
+  }
+  Synth synth = prepared({pianoKeys(48, 52)});
+  SpscQueue<StampedMessage> midi(16);
+  Player player(synth, midi, nullptr, kRate, kFrames);
+  std::vector<float> interleaved(2 * (kBlocks + 1) * kFrames);
+  for (int b = 0; b <= kBlocks; ++b) {
+    const std::int64_t now = kNow + nanoseconds(b * kFrames / kRate);
+    if (b < kBlocks) {
+      ASSERT_TRUE(midi.push({now + nanoseconds(kAhead / kRate), {0x90, uint8_t(48 + b), 100}}));
+    }
+    player.render(interleaved.data() + 2 * b * kFrames, kFrames, now);
+  }
+  for (size_t i = 0; i < l.size(); ++i) {
+    ASSERT_EQ(interleaved[2 * i], l[i]) << "frame " << i;
+    ASSERT_EQ(interleaved[2 * i + 1], r[i]) << "frame " << i;
+  }
+}
+
 // --- The recording tee ---------------------------------------------------------------------------
 
 TEST(Player, RecordingReceivesExactlyTheRenderedSamples) {

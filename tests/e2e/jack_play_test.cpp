@@ -37,6 +37,7 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 extern char** environ;
@@ -83,6 +84,27 @@ bool realtimeAllowed() {
 }
 
 double cents(double measured, double reference) { return 1200.0 * std::log2(measured / reference); }
+
+// An environment variable set for a scope, as it was again after.
+class EnvironmentOverride {
+ public:
+  EnvironmentOverride(std::string name, const std::string& value) : name_(std::move(name)) {
+    if (const char* was = std::getenv(name_.c_str())) was_ = was;
+    ::setenv(name_.c_str(), value.c_str(), 1);
+  }
+  ~EnvironmentOverride() {
+    if (was_)
+      ::setenv(name_.c_str(), was_->c_str(), 1);
+    else
+      ::unsetenv(name_.c_str());
+  }
+  EnvironmentOverride(const EnvironmentOverride&) = delete;
+  EnvironmentOverride& operator=(const EnvironmentOverride&) = delete;
+
+ private:
+  std::string name_;
+  std::optional<std::string> was_;
+};
 
 // What one run of the performance left behind, beside the recording.
 struct Performance {
@@ -623,15 +645,9 @@ TEST_F(JackPlay, TheMidiInputClosesWhileTheGraphChanges) {
   if (!onPath("jackd") || !onPath("jack_lsp"))
     GTEST_SKIP() << "jackd (Debian's jackd2) is not installed";
   ASSERT_NO_FATAL_FAILURE(startServer(false));
-  // This process a client of that server, as the tests' children are (restored at the end).
-  std::vector<std::pair<std::string, std::optional<std::string>>> saved;
-  for (const auto& [name, value] :
-       {std::pair<std::string, std::string>{"JACK_DEFAULT_SERVER", server_},
-        {"JACK_NO_START_SERVER", "1"}}) {
-    const char* was = std::getenv(name.c_str());
-    saved.emplace_back(name, was ? std::optional<std::string>(was) : std::nullopt);
-    ::setenv(name.c_str(), value.c_str(), 1);
-  }
+  // This process a client of that server, as the tests' children are, until the test ends.
+  const EnvironmentOverride server("JACK_DEFAULT_SERVER", server_),
+      noStart("JACK_NO_START_SERVER", "1");
   // Our port's full name, from one opening before the loop.
   std::string ours;
   {
@@ -665,14 +681,12 @@ TEST_F(JackPlay, TheMidiInputClosesWhileTheGraphChanges) {
       input.openVirtualPort("hamiltone-in");
       input.close();
     }
-  } catch (const hamiltone::app::MidiError& e) {
+  } catch (const std::exception& e) {
     ADD_FAILURE() << e.what();
   }
   stop.store(true);
   graph.join();
   jack_client_close(churn);
-  for (const auto& [name, was] : saved)
-    was ? ::setenv(name.c_str(), was->c_str(), 1) : ::unsetenv(name.c_str());
   // Closed means gone from the graph.
   EXPECT_EQ(ports().value_or("").find(":hamiltone-in"), std::string::npos);
 }
