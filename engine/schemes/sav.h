@@ -181,7 +181,13 @@ class SavScheme {
   // vectorised (`omp simd`, with -fopenmp-simd): a fixed, deterministic summation order.
   template <bool lossy>
   void stepInternal() noexcept {
-    const auto [k, up, down, kk, n, minv, qm, q, qp] = view();
+    // Named one by one, not bound as a structure: the lambda below captures them (Clang before
+    // 16 cannot capture structured bindings).
+    const StepView v = view();
+    const double k = v.k, up = v.up, down = v.down, kk = v.kk;
+    const Eigen::Index n = v.n;
+    const double *minv = v.minv, *qm = v.qm, *q = v.q;
+    double* qp = v.qp;
     const double* kq = kq_.data();
 
     // (39): g_j = ∇V'_j / sqrt(2 (V'_j + ε)), g_j = 0 where V'_j + ε = 0; grads_ hold ∇V'_j, so
