@@ -58,7 +58,7 @@ struct MidiInput::Impl {
   // "hamiltone" too, so that our ports keep it: "hamiltone:hamiltone-in" — or when first needed
   // (none while no server answers).
   std::unique_ptr<JackMidiInput> jack;
-  bool open = false;  // a port and the callback are set
+  bool open = false;  // RtMidi's port and callback are set (JACK's: jack->isOpen())
 
   JackMidiInput& jackClient() {
     if (!jack) {
@@ -125,8 +125,8 @@ void MidiInput::openPort(int port) {
     } catch (const RtMidiError& e) {
       throw MidiError("cannot open MIDI port " + std::to_string(port) + ": " + e.getMessage());
     }
+    impl_->open = true;
   }
-  impl_->open = true;
   portName_ = name;
 }
 
@@ -141,8 +141,8 @@ void MidiInput::openVirtualPort(const std::string& name) {
     } catch (const RtMidiError& e) {
       throw MidiError("cannot create the virtual MIDI port \"" + name + "\": " + e.getMessage());
     }
+    impl_->open = true;
   }
-  impl_->open = true;
 }
 
 // A port that failed to open takes its client along (made again when next needed): whatever
@@ -200,7 +200,6 @@ void MidiInput::close() {
     // Whether or not a port opened (connecting it may have failed on an active client):
     // deactivated, then closed, and no callback after this, before the queue it fills goes.
     impl_->jack.reset();
-    impl_->open = false;
     return;
   }
   if (!impl_->open) return;

@@ -41,8 +41,8 @@ class MidiInput {
   static constexpr size_t kQueueSize = 4096;
 
   // api: "jack" or "alsa" (PulseAudio has no MIDI: it uses ALSA's sequencer). Throws MidiError.
-  // On JACK the client is made when first needed: without a server, ports() is empty and opening
-  // a port throws.
+  // On JACK the client is made here, or when first needed if no server answered: without one,
+  // ports() is empty and opening a port throws.
   explicit MidiInput(const std::string& api);
   ~MidiInput();
   std::vector<std::string> ports();

@@ -66,9 +66,9 @@ void Player::render(float* interleaved, int frames, std::int64_t nowNs) noexcept
     if (!m) break;
     const double age = static_cast<double>(nowNs - m->arrivalNs) * 1e-9;
     const long offset = std::lround((period - age) * sampleRate_);
-    // Stamped within the next period (the JACK input stamps a period's events ahead of its own
-    // callback, which may run before ours): left for the next block, where it lands in place —
-    // each message once, so that a clock that does not move cannot hold one for good.
+    // Stamped within the next period (the JACK input stamps a period's events from the cycle's
+    // start, and its callback may run before ours): left for the next block, where it lands in
+    // place — each message once, so that a clock that does not move cannot hold one for good.
     if (offset >= frames && offset < 2L * frames && m->arrivalNs != heldNs_) {
       heldNs_ = m->arrivalNs;
       break;
