@@ -6,6 +6,7 @@
 #include <numbers>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "util/format_number.h"
 
@@ -49,32 +50,58 @@ HammeredString::HammeredString(NonlinearString string, const HammerFelt& felt)
   inverseMass_.head(n) = string_.inverseMass();
   inverseMass_[n] = 1.0 / felt.mass;
 
-  // Interior grid point j (0-based) sits at x = (j + 1) h.
+  // J_j = ∫ φ_j(x) g(x) dx: the felt's raised cosine g (width w, unit area, centred on x0)
+  // against grid point j's hat φ_j (1 at x_j = (j + 1) h, 0 at its neighbours). The hats sum to 1
+  // from the first grid point to the last; w → 0 gives linear interpolation between the two points
+  // around x0, w ≫ h the raised cosine sampled at the points. Simpson's rule on 64 intervals
+  // between each two of the integrand's kinks.
   const double h = string_.spacing();
   const double x0 = felt.position * string_.physics().length;
+  const double halfWidth = 0.5 * felt.width;
   const int points = string_.segments() - 1;
+  auto density = [&](double x) {  // g(x); w = 0 is a point at x0 (below)
+    const double d = (x - x0) / halfWidth;
+    return std::abs(d) < 1.0 ? (1.0 + std::cos(std::numbers::pi * d)) / (2.0 * halfWidth) : 0.0;
+  };
+  auto hat = [&](int j, double x) { return std::max(0.0, 1.0 - std::abs(x / h - (j + 1))); };
   double total = 0.0;
   for (int j = 0; j < points; ++j) {
-    const double d = ((j + 1) * h - x0) / (0.5 * felt.width);
-    if (std::abs(d) < 1.0) {
+    double weight = 0.0;
+    if (halfWidth == 0.0) {
+      weight = hat(j, x0);
+    } else if (j * h < x0 + halfWidth && (j + 2) * h > x0 - halfWidth) {  // they overlap
+      // The integrand's kinks: the hat's three corners and the felt's edges and centre.
+      std::vector<double> knots = {j * h,          (j + 1) * h, (j + 2) * h,
+                                   x0 - halfWidth, x0,          x0 + halfWidth};
+      std::sort(knots.begin(), knots.end());
+      const double lo = std::max(j * h, x0 - halfWidth), hi = std::min((j + 2) * h, x0 + halfWidth);
+      for (size_t k = 0; k + 1 < knots.size(); ++k) {
+        const double a = std::max(knots[k], lo), b = std::min(knots[k + 1], hi);
+        if (!(b > a)) continue;
+        constexpr int kIntervals = 64;  // even
+        const double step = (b - a) / kIntervals;
+        double sum = 0.0;
+        for (int i = 0; i <= kIntervals; ++i) {
+          const double x = a + i * step;
+          const double f = hat(j, x) * density(x);
+          sum += (i == 0 || i == kIntervals ? 1.0 : i % 2 == 1 ? 4.0 : 2.0) * f;
+        }
+        weight += sum * step / 3.0;
+      }
+    }
+    if (weight > 0.0) {
       contactIndex_.push_back(j);
-      contactWeight_.push_back(0.5 * (1.0 + std::cos(std::numbers::pi * d)));
-      total += contactWeight_.back();
+      contactWeight_.push_back(weight);
+      total += weight;
     }
   }
-  if (contactIndex_.empty()) {  // felt narrower than the grid: linear interpolation
-    const double s = std::clamp(x0 / h - 1.0, 0.0, points - 1.0);
-    const int j = std::min(static_cast<int>(s), points - 1);
-    const double frac = s - j;
-    contactIndex_ = {j};
-    contactWeight_ = {1.0 - frac};
-    if (j + 1 < points && frac > 0.0) {
-      contactIndex_.push_back(j + 1);
-      contactWeight_.push_back(frac);
-    }
-    total = 1.0;
-  }
-  for (double& w : contactWeight_) w /= total;
+  // Where the felt lies within a segment of an end, the end's own hat (whose share the fixed end
+  // takes) is missing and Σ J_j < 1: the contact there is the felt's mean of the interpolated u,
+  // which is 0 at the end. Elsewhere the hats sum to 1 and Jᵀ1 = 1 up to Simpson's error: made
+  // exact.
+  const double length = string_.physics().length;
+  if (x0 - halfWidth >= h && x0 + halfWidth <= length - h)
+    for (double& w : contactWeight_) w /= total;
 }
 
 double HammeredString::contactDisplacement(const Vector& q) const {
