@@ -461,9 +461,9 @@ def run(ctx):
         "**Where two-grid does not match.** "
         + ("; ".join(misses) + "." if misses else
            "On glide and between-partials level, nowhere outside the tolerances above.")
-        + (" On the keys it was not developed on: " + "; ".join(held_misses) + ". The short "
-           "strings among them converge on the reference once u's grid is refined with the "
-           "oversampling: at 48 kHz u's grid bounds them, not the coupling of the grids "
+        + (" On the keys it was not developed on: " + "; ".join(held_misses) + ". They converge "
+           "on the reference once both grids are refined with the oversampling: at 48 kHz u's "
+           "grid bounds them, not the coupling of the grids "
            "(docs/string-grids.md, \"Keys the report's first table does not measure\")."
            if held_misses else "")
         + ("" if cost_ok else
