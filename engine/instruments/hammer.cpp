@@ -50,57 +50,41 @@ HammeredString::HammeredString(NonlinearString string, const HammerFelt& felt)
   inverseMass_.head(n) = string_.inverseMass();
   inverseMass_[n] = 1.0 / felt.mass;
 
-  // J_j = ∫ φ_j(x) g(x) dx: the felt's raised cosine g (width w, unit area, centred on x0)
-  // against grid point j's hat φ_j (1 at x_j = (j + 1) h, 0 at its neighbours). The hats sum to 1
-  // from the first grid point to the last; w → 0 gives linear interpolation between the two points
-  // around x0, w ≫ h the raised cosine sampled at the points. Simpson's rule on 64 intervals
-  // between each two of the integrand's kinks.
-  const double h = string_.spacing();
-  const double x0 = felt.position * string_.physics().length;
-  const double halfWidth = 0.5 * felt.width;
-  const int points = string_.segments() - 1;
-  auto density = [&](double x) {  // g(x); w = 0 is a point at x0 (below)
-    const double d = (x - x0) / halfWidth;
-    return std::abs(d) < 1.0 ? (1.0 + std::cos(std::numbers::pi * d)) / (2.0 * halfWidth) : 0.0;
+  // J_j = ∫ φ_j(x) g(x) dx: the felt's raised cosine g(x) = (1 + cos(π(x − x0)/a)) / 2a on
+  // |x − x0| < a = w/2 (unit area) against grid point j's hat φ_j (1 at x_j = (j + 1) h, 0 at its
+  // neighbours). The hats sum to 1 from the first grid point to the last; a → 0 gives linear
+  // interpolation between the two points around x0, a ≫ h the raised cosine sampled at the points.
+  const double h = string_.spacing(), length = string_.physics().length;
+  const double x0 = felt.position * length, a = 0.5 * felt.width;
+  const bool point = a <= 1e-9 * h;  // a felt that narrow presses as a point, to 1e-9 of h
+  const double c = std::numbers::pi / a;
+  // ∫ (P + βt)(1 + cos ct) dt, t = x − x0: the closed form over one side of a hat, φ = P + βt.
+  auto primitive = [c](double p, double beta, double t) {
+    const double sine = std::sin(c * t) / c, cosine = std::cos(c * t) / (c * c);
+    return p * (t + sine) + beta * (0.5 * t * t + t * sine + cosine);
   };
-  auto hat = [&](int j, double x) { return std::max(0.0, 1.0 - std::abs(x / h - (j + 1))); };
+  auto side = [&](double from, double to, double alpha, double beta) {  // φ = α + βx on [from, to]
+    const double t1 = std::max(from, x0 - a) - x0, t2 = std::min(to, x0 + a) - x0;
+    if (!(t2 > t1)) return 0.0;
+    const double p = alpha + beta * x0;
+    return (primitive(p, beta, t2) - primitive(p, beta, t1)) / (2.0 * a);
+  };
+  const int points = string_.segments() - 1;
   double total = 0.0;
   for (int j = 0; j < points; ++j) {
-    double weight = 0.0;
-    if (halfWidth == 0.0) {
-      weight = hat(j, x0);
-    } else if (j * h < x0 + halfWidth && (j + 2) * h > x0 - halfWidth) {  // they overlap
-      // The integrand's kinks: the hat's three corners and the felt's edges and centre.
-      std::vector<double> knots = {j * h,          (j + 1) * h, (j + 2) * h,
-                                   x0 - halfWidth, x0,          x0 + halfWidth};
-      std::sort(knots.begin(), knots.end());
-      const double lo = std::max(j * h, x0 - halfWidth), hi = std::min((j + 2) * h, x0 + halfWidth);
-      for (size_t k = 0; k + 1 < knots.size(); ++k) {
-        const double a = std::max(knots[k], lo), b = std::min(knots[k + 1], hi);
-        if (!(b > a)) continue;
-        constexpr int kIntervals = 64;  // even
-        const double step = (b - a) / kIntervals;
-        double sum = 0.0;
-        for (int i = 0; i <= kIntervals; ++i) {
-          const double x = a + i * step;
-          const double f = hat(j, x) * density(x);
-          sum += (i == 0 || i == kIntervals ? 1.0 : i % 2 == 1 ? 4.0 : 2.0) * f;
-        }
-        weight += sum * step / 3.0;
-      }
-    }
+    const double weight = point ? std::max(0.0, 1.0 - std::abs(x0 / h - (j + 1)))
+                                : side(j * h, (j + 1) * h, -j, 1.0 / h) +
+                                      side((j + 1) * h, (j + 2) * h, j + 2.0, -1.0 / h);
     if (weight > 0.0) {
       contactIndex_.push_back(j);
       contactWeight_.push_back(weight);
       total += weight;
     }
   }
-  // Where the felt lies within a segment of an end, the end's own hat (whose share the fixed end
+  // Where the felt reaches into a segment at an end, that end's hat (whose share the fixed end
   // takes) is missing and Σ J_j < 1: the contact there is the felt's mean of the interpolated u,
-  // which is 0 at the end. Elsewhere the hats sum to 1 and Jᵀ1 = 1 up to Simpson's error: made
-  // exact.
-  const double length = string_.physics().length;
-  if (x0 - halfWidth >= h && x0 + halfWidth <= length - h)
+  // which is 0 at the end. Elsewhere the hats sum to 1 and so does J, to roundoff: made exact.
+  if (x0 - a >= h && x0 + a <= length - h)
     for (double& w : contactWeight_) w /= total;
 }
 

@@ -36,10 +36,11 @@ class Hammer {
 
 // q = [u; v; w]: the string's coordinates and the hammer's height w (positive towards the string).
 // J spreads the contact as the felt presses on the string: J_j = ∫ φ_j g dx, g the felt's raised
-// cosine (unit area, its width, centred on the strike point) and φ_j grid point j's hat, normalised
-// so that Jᵀ1 = 1. Jᵀ of a mode shape is then the felt's own excitation of the mode, to within the
-// linear interpolation of the mode between grid points, on any grid: a grid coarser than the felt
-// does not move the strike to its nearest point.
+// cosine (unit area, its width, centred on the strike point) and φ_j grid point j's hat, so that
+// Jᵀ1 = 1 (less the share of a fixed end the felt reaches within a segment of). Jᵀ of a mode shape
+// is then the felt's own excitation of the mode, to within the linear interpolation of the mode
+// between grid points, on any grid: a grid coarser than the felt does not move the strike to its
+// nearest point.
 class HammeredString {
  public:
   static constexpr bool hasStiffness = true;

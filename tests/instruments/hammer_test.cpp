@@ -40,11 +40,12 @@ TEST(HammeredString, GradientIsTheDerivativeOfThePotential) {
 }
 
 // Σ J_j x_j = ∫ g(x) Σ φ_j(x) x_j dx = ∫ g x dx = x0: the hats interpolate x exactly, the fixed end
-// included (x = 0 there). Σ J_j = ∫ g Σ φ_j = 1 where the felt lies between the first and last grid
-// points; on 8 segments the strike (0.151 m, the felt ±5 mm) lies in the first (h = 0.157 m),
-// where Σ φ_j = x/h, so Σ J_j = x0/h: the fixed end takes the rest of the felt's push.
+// at x = 0 included (not the one at L, whose x is not 0). Σ J_j = ∫ g Σ φ_j = 1 where the felt lies
+// between the first and last grid points; on 8 segments the strike (0.151 m, the felt ±5 mm) lies
+// in the first (h = 0.157 m), where Σ φ_j = x/h, so Σ J_j = x0/h: the fixed end takes the rest of
+// the felt's push. 126 and 180 segments put x0 between grid points (100 and 400 on one).
 TEST(HammeredString, ContactSpreadHasUnitSumAndIsCentredOnTheStrikePoint) {
-  for (int segments : {8, 100, 400}) {
+  for (int segments : {8, 100, 126, 180, 400}) {
     HammerFelt felt;
     const HammeredString system(NonlinearString(c3(), segments), felt);
     Vector q = Vector::Zero(system.size());
@@ -59,7 +60,26 @@ TEST(HammeredString, ContactSpreadHasUnitSumAndIsCentredOnTheStrikePoint) {
       centre += w * (j + 1) * h;
     }
     EXPECT_NEAR(sum, segments == 8 ? x0 / h : 1.0, 1e-12) << segments;
-    EXPECT_NEAR(centre, x0, 1e-9 * h) << segments;
+    EXPECT_NEAR(centre, x0, 1e-12 * x0) << segments;
+  }
+}
+
+// A felt far narrower than the grid presses as a point: J interpolates linearly between the two
+// grid points around x0 (126 segments: x0 between them), so Jᵀ1 = 1 and Jᵀx = x0 — for a width of
+// 0, of 1e-20 m (x0 ± w/2 rounds to x0: a point, not an empty J) and of 1 µm.
+TEST(HammeredString, AFeltFarNarrowerThanTheGridPressesAsAPoint) {
+  for (double width : {0.0, 1e-20, 1e-6}) {
+    HammerFelt felt;
+    felt.width = width;
+    const HammeredString system(NonlinearString(c3(), 126), felt);
+    const double h = system.string().spacing();
+    Vector ones = Vector::Zero(system.size()), x = Vector::Zero(system.size());
+    for (Eigen::Index j = 0; j < system.size() - 1; ++j) {
+      ones[j] = 1.0;
+      x[j] = (j + 1) * h;
+    }
+    EXPECT_NEAR(system.contactDisplacement(ones), 1.0, 1e-12) << width;
+    EXPECT_NEAR(system.contactDisplacement(x), felt.position * 1.259, 1e-12) << width;
   }
 }
 
