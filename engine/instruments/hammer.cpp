@@ -14,7 +14,7 @@ namespace hamiltone {
 
 namespace {
 
-void require(bool ok, const char* field, double value, const char* valid) {
+void require(bool ok, const char* field, double value, const std::string& valid) {
   if (!ok)
     throw std::invalid_argument(std::string("hammer ") + field + " = " + formatNumber(value) +
                                 ": must be " + valid);
@@ -56,6 +56,11 @@ HammeredString::HammeredString(NonlinearString string, const HammerFelt& felt)
   // interpolation between the two points around x0, a ≫ h the raised cosine sampled at the points.
   const double h = string_.spacing(), length = string_.physics().length;
   const double x0 = felt.position * length, a = 0.5 * felt.width;
+  const double room = 2.0 * std::min(x0, length - x0);
+  require(felt.width < room, "width", felt.width,
+          "under 2 min(x0, L - x0) = " + formatApprox(room) + " m, so that the felt lies on the " +
+              formatApprox(length) + " m string struck at " + formatNumber(felt.position) +
+              " of it");
   const bool point = a <= 1e-9 * h;  // a felt that narrow presses as a point, to 1e-9 of h
   const double c = std::numbers::pi / a;
   // ∫ (P + βt)(1 + cos ct) dt, t = x − x0: the closed form over one side of a hat, φ = P + βt.

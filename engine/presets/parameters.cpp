@@ -264,7 +264,8 @@ constexpr Parameter kTable[] = {
      .max = 0.1,
      .defaultText = "0.01",
      .model = kString,
-     .doc = "Width of the felt's contact on the string."},
+     .doc = "Width of the felt's contact on the string, spread as the felt presses; under "
+            "2 min(x0, L - x0) at every key, so that the felt lies on the string."},
     {.name = "hammer.velocity_min_m_s",
      .unit = "m/s",
      .min = 0,

@@ -32,9 +32,9 @@ std::string sourcePath(const std::string& relative) {
 }
 
 // The lines of the PresetError that loading `file` throws (none if it loads).
-std::vector<std::string> errorsOf(const std::string& file) {
+std::vector<std::string> errorsOf(const std::string& file, const PresetOptions& options = {}) {
   try {
-    loadPreset(file);
+    loadPreset(file, options);
   } catch (const PresetError& e) {
     return e.lines;
   }
@@ -574,17 +574,31 @@ TEST(PresetOverrides, ErrorsListTheFileThenEachSetInOrder) {
                           "test.toml: --set gain_dB=x: expected a number"));
 }
 
+// A felt wider than the string has room for at its strike point (2 min(x0, L − x0)) is refused
+// where the string is too short for it: grand-piano's top keys with a 2 cm felt, each line naming
+// the --set and the key; 1.1 cm fits them all (C8: 4.98 cm struck at 0.12, room for 1.2 cm).
+TEST(PresetOverrides, AFeltWiderThanItsStringIsRefused) {
+  const std::string piano = sourcePath("presets/grand-piano.toml");
+  const std::vector<std::string> lines =
+      errorsOf(piano, {.overrides = {{"hammer.width_m", "0.02"}}});
+  ASSERT_FALSE(lines.empty());
+  for (const std::string& line : lines)
+    EXPECT_THAT(line, AllOf(HasSubstr("--set hammer.width_m=0.02 at "),
+                            HasSubstr("so that the felt lies on the")));
+  // The first key without room is D#7 (8.06 cm: room for 1.93 cm); the lines go up from there.
+  EXPECT_THAT(lines.front(),
+              HasSubstr("at D#7: must be under 2 min(x0, L - x0) = 0.01934 m, so "
+                        "that the felt lies on the 0.08059 m string struck at 0.12"));
+  EXPECT_NO_THROW(loadPreset(piano, {.overrides = {{"hammer.width_m", "0.011"}}}));
+}
+
 // A grid the string cannot have (the longitudinal rule at the base rate makes h longer than the
 // treble strings) is the voices' refusal: each line names the setting the voice names and every
 // --set it was built with.
 TEST(PresetOverrides, VoiceCheckNamesTheSets) {
   const std::string piano = sourcePath("presets/grand-piano.toml");
-  std::vector<std::string> lines;
-  try {
-    loadPreset(piano, {.overrides = {{"scheme.grid_rule", "longitudinal"}}});
-  } catch (const PresetError& e) {
-    lines = e.lines;
-  }
+  const std::vector<std::string> lines =
+      errorsOf(piano, {.overrides = {{"scheme.grid_rule", "longitudinal"}}});
   ASSERT_FALSE(lines.empty());
   for (const std::string& line : lines) {
     EXPECT_THAT(line, HasSubstr("shorter than two grid spacings"));
