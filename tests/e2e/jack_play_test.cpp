@@ -47,6 +47,7 @@ extern char** environ;
 #include "support/jack_log.h"
 #include "support/midi_writer.h"
 #include "support/recording.h"
+#include "support/scoped_environment.h"
 #include "support/sent_score.h"
 #include "support/spectrum.h"
 #include "support/tiny_disk.h"
@@ -84,27 +85,6 @@ bool realtimeAllowed() {
 }
 
 double cents(double measured, double reference) { return 1200.0 * std::log2(measured / reference); }
-
-// An environment variable set for a scope, as it was again after.
-class EnvironmentOverride {
- public:
-  EnvironmentOverride(std::string name, const std::string& value) : name_(std::move(name)) {
-    if (const char* was = std::getenv(name_.c_str())) was_ = was;
-    ::setenv(name_.c_str(), value.c_str(), 1);
-  }
-  ~EnvironmentOverride() {
-    if (was_)
-      ::setenv(name_.c_str(), was_->c_str(), 1);
-    else
-      ::unsetenv(name_.c_str());
-  }
-  EnvironmentOverride(const EnvironmentOverride&) = delete;
-  EnvironmentOverride& operator=(const EnvironmentOverride&) = delete;
-
- private:
-  std::string name_;
-  std::optional<std::string> was_;
-};
 
 // What one run of the performance left behind, beside the recording.
 struct Performance {
@@ -647,7 +627,7 @@ TEST_F(JackPlay, TheMidiInputClosesWhileTheGraphChanges) {
     GTEST_SKIP() << "jackd (Debian's jackd2) is not installed";
   ASSERT_NO_FATAL_FAILURE(startServer(false));
   // This process a client of that server, as the tests' children are, until the test ends.
-  const EnvironmentOverride server("JACK_DEFAULT_SERVER", server_),
+  const hamiltone::testing::ScopedEnvironment server("JACK_DEFAULT_SERVER", server_),
       noStart("JACK_NO_START_SERVER", "1");
   const std::string ours = "hamiltone:hamiltone-in";
   {

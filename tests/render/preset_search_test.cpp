@@ -5,12 +5,11 @@
 #include "preset_search.h"
 
 #include <gtest/gtest.h>
-#include <stdlib.h>
 
 #include <fstream>
-#include <optional>
 #include <string>
 
+#include "support/scoped_environment.h"
 #include "support/scratch_dir.h"
 #include "usage_error.h"
 
@@ -20,27 +19,7 @@ namespace fs = std::filesystem;
 using hamiltone::cli::presetDirectories;
 using hamiltone::cli::resolvePreset;
 using hamiltone::cli::UsageError;
-
-// Sets an environment variable for one test, restoring it after.
-class ScopedEnvironment {
- public:
-  ScopedEnvironment(const char* name, const std::string& value) : name_(name) {
-    if (const char* old = std::getenv(name)) old_ = old;
-    ::setenv(name, value.c_str(), 1);
-  }
-  ~ScopedEnvironment() {
-    if (old_)
-      ::setenv(name_, old_->c_str(), 1);
-    else
-      ::unsetenv(name_);
-  }
-  ScopedEnvironment(const ScopedEnvironment&) = delete;
-  ScopedEnvironment& operator=(const ScopedEnvironment&) = delete;
-
- private:
-  const char* name_;
-  std::optional<std::string> old_;
-};
+using hamiltone::testing::ScopedEnvironment;
 
 fs::path put(const fs::path& dataDir, const std::string& file) {
   const fs::path dir = dataDir / "hamiltone" / "presets";

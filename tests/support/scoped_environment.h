@@ -1,0 +1,34 @@
+// An environment variable set for a scope (a test, or part of one), as it was again after: set
+// back to its old value, or unset if it had none.
+#pragma once
+
+#include <stdlib.h>
+
+#include <cstdlib>
+#include <optional>
+#include <string>
+#include <utility>
+
+namespace hamiltone::testing {
+
+class ScopedEnvironment {
+ public:
+  ScopedEnvironment(std::string name, const std::string& value) : name_(std::move(name)) {
+    if (const char* old = std::getenv(name_.c_str())) old_ = old;
+    ::setenv(name_.c_str(), value.c_str(), 1);
+  }
+  ~ScopedEnvironment() {
+    if (old_)
+      ::setenv(name_.c_str(), old_->c_str(), 1);
+    else
+      ::unsetenv(name_.c_str());
+  }
+  ScopedEnvironment(const ScopedEnvironment&) = delete;
+  ScopedEnvironment& operator=(const ScopedEnvironment&) = delete;
+
+ private:
+  std::string name_;
+  std::optional<std::string> old_;
+};
+
+}  // namespace hamiltone::testing
