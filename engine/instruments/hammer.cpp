@@ -6,7 +6,6 @@
 #include <numbers>
 #include <stdexcept>
 #include <string>
-#include <vector>
 
 #include "util/format_number.h"
 

@@ -217,9 +217,11 @@ def spectra_figure(ctx, runs, partials, midi):
                       "modes.")
 
 
-def judge(g, ref, partials_g, partials_ref, floor):
+def judge(g, ref, partials, midi, floor):
     """One key and velocity against the acceptance: (glide ratio, held to the tolerance, glide
     off, between-partials difference, between-partials off, what misses, in words)."""
+    partials_g = partials[midi, "two-grid", "transverse"]
+    partials_ref = partials[midi, "longitudinal", "transverse"]
     ratio = g["glide"] / ref["glide"] if ref["glide"] != 0 else math.nan
     held = abs(ref["glide"]) > GLIDE_FLOOR
     glide_off = held and abs(ratio - 1) > GLIDE_TOLERANCE
@@ -257,9 +259,7 @@ def held_out(ctx, floor):
     for midi in HELD_OUT_KEYS:
         for v in HELD_OUT_VELOCITIES:
             g, ref = runs[midi, v, "two-grid"], runs[midi, v, "longitudinal"]
-            ratio, held, glide_off, diff, phantom_off, said = judge(
-                g, ref, partials[midi, "two-grid", "transverse"],
-                partials[midi, "longitudinal", "transverse"], floor)
+            ratio, held, glide_off, diff, phantom_off, said = judge(g, ref, partials, midi, floor)
             counted += held
             misses += said
             lines.append(
@@ -353,9 +353,7 @@ def run(ctx):
     for midi in keys:
         for v in velocities:
             t, g, ref = (runs[midi, v, c] for c in CONFIGS)
-            ratio, held, glide_off, diff, phantom_off, said = judge(
-                g, ref, partials[midi, "two-grid", "transverse"],
-                partials[midi, "longitudinal", "transverse"], floor)
+            ratio, held, glide_off, diff, phantom_off, said = judge(g, ref, partials, midi, floor)
             counted += held
             misses += said
             cost.setdefault(midi, []).append(g["ns"] / t["ns"])
