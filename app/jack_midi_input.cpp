@@ -37,6 +37,7 @@ JackMidiInput::JackMidiInput(const std::string& clientName) {
                     "\" (jack_client_open status " + hex(static_cast<unsigned>(status)) + ")");
   // Both before activation, as libjack asks.
   jack_set_process_callback(client_, &JackMidiInput::process, this);
+  jack_set_port_registration_callback(client_, &JackMidiInput::registered, this);
   jack_on_shutdown(client_, &JackMidiInput::serverGone, this);
 }
 
@@ -76,6 +77,27 @@ void JackMidiInput::connect(const std::string& source) {
   if (result != 0 && result != EEXIST)
     throw MidiError("cannot connect the MIDI port \"" + source + "\" to " + jack_port_name(port_) +
                     " (jack_connect returned " + std::to_string(result) + ")");
+  const std::lock_guard lock(sourceLock_);
+  source_ = source;
+  sourceRegistered_.store(false);
+}
+
+bool JackMidiInput::sourceReturned() {
+  if (!port_ || gone_.load() || !sourceRegistered_.exchange(false)) return false;
+  const std::lock_guard lock(sourceLock_);
+  return jack_port_by_name(client_, source_.c_str()) &&
+         !jack_port_connected_to(port_, source_.c_str());
+}
+
+// On the client's notification thread (not the process thread): a port of the source's name
+// registered.
+void JackMidiInput::registered(jack_port_id_t port, int registering, void* self) {
+  auto* in = static_cast<JackMidiInput*>(self);
+  if (!registering) return;
+  const jack_port_t* p = jack_port_by_id(in->client_, port);
+  const char* name = p ? jack_port_name(p) : nullptr;
+  const std::lock_guard lock(in->sourceLock_);
+  if (name && !in->source_.empty() && in->source_ == name) in->sourceRegistered_.store(true);
 }
 
 void JackMidiInput::close() noexcept {

@@ -178,6 +178,10 @@ bool MidiInput::portPresent() {
   });
 }
 
+bool MidiInput::portReturned() {
+  return api_ == "jack" && impl_->jack && impl_->jack->sourceReturned();
+}
+
 void MidiInput::reconnect() {
   const std::string name = portName_;
   const std::vector<std::string> names = ports();

@@ -57,6 +57,10 @@ class MidiInput {
   // Connects again to the port of that name (as portPresent() compares them), wherever it is now.
   // Throws MidiError.
   void reconnect();
+  // On JACK: the port went and came back since the last call, too fast for a poll of
+  // portPresent() to see it gone, and is not connected now (JackMidiInput::sourceReturned()); it
+  // takes reconnect(). Elsewhere false: RtMidi does not say whether its subscription still holds.
+  bool portReturned();
 
   SpscQueue<StampedMessage>& queue() { return queue_; }
   long dropped() const { return dropped_.load(); }  // the queue was full

@@ -322,6 +322,20 @@ int play(const PlayArguments& a) {
         } catch (const MidiError&) {
           portGone = true;  // tried again in a second
         }
+    } else if (polls % 4 == 0 && !portGone && midi.portReturned()) {
+      // Unplugged and plugged in again between two polls: its connection went with the old port.
+      try {
+        midi.reconnect();
+        std::fprintf(stderr,
+                     "%shamiltone-play: the MIDI input port \"%s\" went and came back: connected "
+                     "again\n",
+                     status ? "\n" : "", midi.portName().c_str());
+      } catch (const MidiError& e) {
+        std::fprintf(stderr,
+                     "%shamiltone-play: warning: the MIDI input port \"%s\" came back but could "
+                     "not be connected again: %s; restart with --midi-port N\n",
+                     status ? "\n" : "", midi.portName().c_str(), e.what());
+      }
     }
     // A failed recording is said at once, on a line of its own; the sound plays on.
     if (recorder && recorder->failed() && !recordingFailureShown) {

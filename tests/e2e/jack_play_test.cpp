@@ -4,8 +4,9 @@
 // every note on time, in tune and on the instrument its program selects — with no underrun and
 // exit code 0; --notes and --midi played live to their end, on pitch at the server's rate (44.1
 // and 96 kHz); the warnings for no MIDI input and a port that goes, and the line that says why
-// the voice limit dropped; with no server, the player's one-line refusal and exit code 2; and the
-// player's JACK MIDI input (app/jack_midi_input.h) closed again and again while the graph changes.
+// the voice limit dropped; a keyboard plugged in again between two polls; with no server, the
+// player's one-line refusal and exit code 2; and the player's JACK MIDI input
+// (app/jack_midi_input.h) closed again and again while the graph changes.
 //
 // Every process is started here and stopped by its PID; the server has a name of its own
 // (jackd -n, JACK_DEFAULT_SERVER for the clients), so a developer's JACK server is never touched
@@ -712,6 +713,62 @@ TEST_F(JackPlay, WarnsOfNoMidiInputAndOfAPortThatGoes) {
   player_->signal(SIGINT);
   EXPECT_EQ(player_->wait(30.0), 0) << slurp(dir_ / "player.err");
   EXPECT_EQ(slurp(dir_ / "player.err").find("no MIDI input is connected, so"), std::string::npos);
+}
+
+// A keyboard unplugged and plugged in again between two of the player's once-a-second polls: the
+// port of its name is there at every poll, but the connection went with the old port. Its output
+// port here is this process's, unregistered and registered again within milliseconds; the player
+// connects to it again (saying so), where before it stayed silent for good. A port the user
+// disconnects, which stays registered, is left disconnected.
+TEST_F(JackPlay, ConnectsAgainToAKeyboardRepluggedBetweenTwoPolls) {
+  if (!onPath("jackd") || !onPath("jack_lsp"))
+    GTEST_SKIP() << "jackd (Debian's jackd2) is not installed";
+  ASSERT_NO_FATAL_FAILURE(startServer(false));
+  const hamiltone::testing::ScopedEnvironment server("JACK_DEFAULT_SERVER", server_),
+      noStart("JACK_NO_START_SERVER", "1");
+  jack_client_t* keys = jack_client_open("fastkeys", JackNoStartServer, nullptr);
+  ASSERT_NE(keys, nullptr);
+  auto registerOut = [&] {
+    return jack_port_register(keys, "out", JACK_DEFAULT_MIDI_TYPE, JackPortIsOutput, 0);
+  };
+  jack_port_t* out = registerOut();
+  ASSERT_NE(out, nullptr);
+  ASSERT_EQ(jack_activate(keys), 0);
+  const std::string paper = HAMILTONE_SOURCE_DIR "/presets/paper-c3-string.toml";
+  spawn(player_,
+        {HAMILTONE_PLAY, "--api", "jack", "--quiet", "--preset", paper, "--midi-port", "0"},
+        "player");
+  auto connected = [&] {
+    for (int i = 0; i < 50 && jack_port_connected(out) == 0; ++i)
+      std::this_thread::sleep_for(100ms);
+    return jack_port_connected(out) > 0;
+  };
+  ASSERT_TRUE(connected()) << slurp(dir_ / "player.err");
+
+  ASSERT_EQ(jack_port_unregister(keys, out), 0);
+  out = registerOut();
+  ASSERT_NE(out, nullptr);
+  // Nearly always between two polls; a poll that fell in the gap took the slower way.
+  const std::string fast =
+                        "the MIDI input port \"fastkeys:out\" went and came back: connected "
+                        "again",
+                    slow = "the MIDI input port \"fastkeys:out\" is back: connected";
+  std::string err;
+  for (int i = 0; i < 50; ++i, std::this_thread::sleep_for(100ms)) {
+    err = slurp(dir_ / "player.err");
+    if (err.find(fast) != std::string::npos || err.find(slow) != std::string::npos) break;
+  }
+  EXPECT_TRUE(err.find(fast) != std::string::npos || err.find(slow) != std::string::npos) << err;
+  EXPECT_TRUE(connected()) << err;
+
+  // Disconnected by hand, the port staying: left so over three polls.
+  ASSERT_EQ(jack_disconnect(keys, "fastkeys:out", "hamiltone:hamiltone-in"), 0);
+  std::this_thread::sleep_for(3500ms);
+  EXPECT_EQ(jack_port_connected(out), 0) << slurp(dir_ / "player.err");
+  EXPECT_FALSE(player_->wait(0.1)) << slurp(dir_ / "player.err");
+  player_->signal(SIGINT);
+  EXPECT_EQ(player_->wait(30.0), 0) << slurp(dir_ / "player.err");
+  jack_client_close(keys);
 }
 
 // A budget no callback can keep (--cpu-limit 0.001 %) drops the voice limit while the six-key
