@@ -35,9 +35,10 @@ JackMidiInput::JackMidiInput(const std::string& clientName) {
   if (!client_)
     throw MidiError("MIDI input on jack: the server refused the client \"" + clientName +
                     "\" (jack_client_open status " + hex(static_cast<unsigned>(status)) + ")");
-  // Both before activation, as libjack asks.
+  // All before activation, as libjack asks.
   jack_set_process_callback(client_, &JackMidiInput::process, this);
   jack_set_port_registration_callback(client_, &JackMidiInput::registered, this);
+  jack_set_port_connect_callback(client_, &JackMidiInput::connected, this);
   jack_on_shutdown(client_, &JackMidiInput::serverGone, this);
 }
 
@@ -73,31 +74,52 @@ void JackMidiInput::open(const std::string& portName, const std::string& source,
 
 void JackMidiInput::connect(const std::string& source) {
   if (!port_) throw MidiError("no JACK MIDI input port is open");
+  {
+    // Before jack_connect (and not around it): a registration of the source from here on is seen.
+    const std::lock_guard lock(sourceLock_);
+    source_ = source;
+    sourceRegistered_.store(false);
+  }
   const int result = jack_connect(client_, source.c_str(), jack_port_name(port_));
   if (result != 0 && result != EEXIST)
     throw MidiError("cannot connect the MIDI port \"" + source + "\" to " + jack_port_name(port_) +
                     " (jack_connect returned " + std::to_string(result) + ")");
-  const std::lock_guard lock(sourceLock_);
-  source_ = source;
-  sourceRegistered_.store(false);
 }
 
 bool JackMidiInput::sourceReturned() {
   if (!port_ || gone_.load() || !sourceRegistered_.exchange(false)) return false;
   const std::lock_guard lock(sourceLock_);
-  return jack_port_by_name(client_, source_.c_str()) &&
-         !jack_port_connected_to(port_, source_.c_str());
+  return jack_port_by_name(client_, returned_.c_str()) &&
+         !jack_port_connected_to(port_, returned_.c_str());
 }
 
-// On the client's notification thread (not the process thread): a port of the source's name
-// registered.
+// On the client's notification thread (not the process thread), in the order the graph changed:
+// a port of the source's stable name (an a2j port's ALSA client number may change) registered.
 void JackMidiInput::registered(jack_port_id_t port, int registering, void* self) {
   auto* in = static_cast<JackMidiInput*>(self);
-  if (!registering) return;
-  const jack_port_t* p = jack_port_by_id(in->client_, port);
-  const char* name = p ? jack_port_name(p) : nullptr;
+  const jack_port_t* p = registering ? jack_port_by_id(in->client_, port) : nullptr;
+  if (!p) return;
+  const std::string name = jack_port_name(p);
   const std::lock_guard lock(in->sourceLock_);
-  if (name && !in->source_.empty() && in->source_ == name) in->sourceRegistered_.store(true);
+  if (in->source_.empty() || stablePortName(name) != stablePortName(in->source_)) return;
+  in->returned_ = name;
+  in->sourceRegistered_.store(true);
+}
+
+// Likewise: a port of the source's name connected to ours (by us, or by anyone) — nothing left to
+// do, so a later disconnection by hand is not undone.
+void JackMidiInput::connected(jack_port_id_t a, jack_port_id_t b, int connecting, void* self) {
+  auto* in = static_cast<JackMidiInput*>(self);
+  const jack_port_t* pa = jack_port_by_id(in->client_, a);
+  const jack_port_t* pb = jack_port_by_id(in->client_, b);
+  if (!connecting || !pa || !pb || !in->port_) return;
+  const std::string ours = jack_port_name(in->port_), nameA = jack_port_name(pa),
+                    nameB = jack_port_name(pb);
+  if (nameA != ours && nameB != ours) return;
+  const std::string& other = nameA == ours ? nameB : nameA;
+  const std::lock_guard lock(in->sourceLock_);
+  if (!in->source_.empty() && stablePortName(other) == stablePortName(in->source_))
+    in->sourceRegistered_.store(false);
 }
 
 void JackMidiInput::close() noexcept {

@@ -40,10 +40,10 @@ class JackMidiInput {
   void open(const std::string& portName, const std::string& source, Arrival arrival, void* user);
   // Connects `source` to the open port again (a keyboard that came back). Throws MidiError.
   void connect(const std::string& source);
-  // Whether the source last connected registered its port again since the last call (a keyboard
-  // unplugged and plugged in again, its client restarted), and the port is not connected to it
-  // now: the connection went with the old port. A source the user disconnected, whose port stayed,
-  // is not.
+  // Whether a port of the last connected source's stable name (stablePortName) registered since
+  // the last call (a keyboard unplugged and plugged in again, its client restarted) and no one
+  // connected it to ours since: the connection went with the old port. A source the user
+  // disconnected, whose port stayed, is not.
   bool sourceReturned();
   // Deactivates the client, then closes it: no callback runs after this returns. jackd2 cancels
   // the process thread on deactivation, so a callback must not be inside ours then (cancelled in a
@@ -56,6 +56,7 @@ class JackMidiInput {
   static int process(jack_nframes_t frames, void* self);
   static void serverGone(void* self);
   static void registered(jack_port_id_t port, int registering, void* self);  // notifications
+  static void connected(jack_port_id_t a, jack_port_id_t b, int connecting, void* self);
 
   jack_client_t* client_ = nullptr;
   jack_port_t* port_ = nullptr;
@@ -65,8 +66,10 @@ class JackMidiInput {
   std::atomic<bool> gone_{false};   // the server shut the client down
   std::atomic<bool> closing_{false};
   std::atomic<int> returnedClosing_{0};  // callbacks that returned at once, closing_ set
-  std::mutex sourceLock_;                // source_, between connect() and the notification thread
-  std::string source_;
+  // source_ (the port last connected) and returned_ (the port of its stable name that registered
+  // since), between connect() and the notification thread.
+  std::mutex sourceLock_;
+  std::string source_, returned_;
   std::atomic<bool> sourceRegistered_{false};
 };
 

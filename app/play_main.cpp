@@ -330,11 +330,8 @@ int play(const PlayArguments& a) {
                      "%shamiltone-play: the MIDI input port \"%s\" went and came back: connected "
                      "again\n",
                      status ? "\n" : "", midi.portName().c_str());
-      } catch (const MidiError& e) {
-        std::fprintf(stderr,
-                     "%shamiltone-play: warning: the MIDI input port \"%s\" came back but could "
-                     "not be connected again: %s; restart with --midi-port N\n",
-                     status ? "\n" : "", midi.portName().c_str(), e.what());
+      } catch (const MidiError&) {
+        portGone = true;  // gone again: the check above connects it when it is back
       }
     }
     // A failed recording is said at once, on a line of its own; the sound plays on.
