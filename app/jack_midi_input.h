@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "synth/nonblocking.h"
+
 namespace hamiltone::app {
 
 class JackMidiInput {
@@ -53,7 +55,7 @@ class JackMidiInput {
   bool isOpen() const { return port_ != nullptr; }
 
  private:
-  static int process(jack_nframes_t frames, void* self);
+  static int process(jack_nframes_t frames, void* self) HAMILTONE_NONBLOCKING;  // tests/rtsan
   static void serverGone(void* self);
   static void registered(jack_port_id_t port, int registering, void* self);  // notifications
   static void connected(jack_port_id_t a, jack_port_id_t b, int connecting, void* self);

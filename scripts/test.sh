@@ -26,9 +26,10 @@ ctest --test-dir build/fuzz --output-on-failure
 
 # The RealtimeSanitizer tests (tests/rtsan) need Clang 20 or later, Debian's clang-22; their tree,
 # like the fuzzers', builds only their own targets (the engine compiled in with the player, or with
-# the plugin and DPF's CLAP entry; without render/ and app/'s audio libraries). Any allocation,
-# lock or syscall inside Player::render or the plugin's process call, or in the synthesizer's
-# worker threads while they render keys, fails them.
+# the plugin and DPF's CLAP entry, or the player's MIDI input with RtMidi and libjack; without
+# render/ and RtAudio). Any allocation, lock or syscall inside Player::render, the JACK MIDI
+# input's process callback or the plugin's process call, or in the synthesizer's worker threads
+# while they render keys, fails them.
 CC=clang-22 CXX=clang++-22 cmake -S . -B build/rtsan -G Ninja -DHAMILTONE_RTSAN=ON \
   -DHAMILTONE_BUILD_TESTS=OFF -DHAMILTONE_BUILD_BENCH=OFF -DHAMILTONE_BUILD_RENDER=OFF >/dev/null
 cmake --build build/rtsan --target hamiltone_rtsan_tests

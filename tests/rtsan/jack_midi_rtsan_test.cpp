@@ -1,0 +1,136 @@
+// The player's JACK MIDI input under RealtimeSanitizer: JackMidiInput::process, which libjack runs
+// on the server's real-time process thread, is [[clang::nonblocking]], so in this binary (its
+// sources compiled with -fsanitize=realtime) any allocation, lock or blocking syscall made while
+// it hands a period's events to MidiInput's lock-free queue — by our code, the C++ library or
+// libjack's own calls into libc — ends the process with a report and a nonzero exit.
+// A JACK server of its own (jackd on the dummy driver, named for this process) runs for the test;
+// a client here plays seven note-ons and offs a period at spread frames into the player's input
+// port for 2 s, and every one must arrive. Exit 77 (skipped) without jackd. Without GoogleTest:
+// nothing but the code under test runs.
+#include <jack/jack.h>
+#include <jack/midiport.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <thread>
+
+#include "midi_input.h"
+
+namespace {
+
+constexpr int kPerPeriod = 7;  // note-ons and offs written a period
+
+// The keyboard: kPerPeriod events at spread frames of every period, counted as written.
+struct Keys {
+  jack_port_t* out = nullptr;
+  std::atomic<long> written{0};
+  std::atomic<bool> playing{false};
+  int note = 0;
+
+  static int process(jack_nframes_t frames, void* self) {
+    auto* keys = static_cast<Keys*>(self);
+    void* buffer = jack_port_get_buffer(keys->out, frames);
+    jack_midi_clear_buffer(buffer);
+    if (!keys->playing.load()) return 0;
+    for (int i = 0; i < kPerPeriod; ++i) {
+      const unsigned char event[3] = {static_cast<unsigned char>(i % 2 ? 0x80 : 0x90),
+                                      static_cast<unsigned char>(36 + keys->note++ % 60), 100};
+      if (jack_midi_event_write(buffer, frames * i / kPerPeriod, event, sizeof event) == 0)
+        keys->written.fetch_add(1);
+    }
+    return 0;
+  }
+};
+
+bool onPath(const char* program) {
+  const std::string command = std::string("command -v ") + program + " >/dev/null 2>&1";
+  return std::system(command.c_str()) == 0;
+}
+
+}  // namespace
+
+int main() {
+  using namespace std::chrono_literals;
+  if (!onPath("jackd")) {
+    std::printf("jackd (Debian's jackd2) is not installed: skipped\n");
+    return 77;
+  }
+  const std::string server = "hamiltone-rtsan-" + std::to_string(getpid());
+  setenv("JACK_DEFAULT_SERVER", server.c_str(), 1);
+  setenv("JACK_NO_START_SERVER", "1", 1);
+  const char* argv[] = {"jackd", "-n",    server.c_str(), "--no-realtime", "-d",   "dummy",
+                        "-r",    "48000", "-p",           "256",           nullptr};
+  // The server ends with this process, whichever way it ends (RTSan's report exits at once).
+  const pid_t parent = getpid();
+  const pid_t jackd = fork();
+  if (jackd == 0) {
+    prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (getppid() != parent) _exit(1);
+    execvp("jackd", const_cast<char**>(argv));
+    _exit(127);
+  }
+  if (jackd < 0) {
+    std::printf("cannot start jackd\n");
+    return 1;
+  }
+  int failures = 0;
+  {
+    jack_client_t* client = nullptr;
+    for (int i = 0; i < 150 && !client; ++i) {
+      client = jack_client_open("rtsan-keys", JackNoStartServer, nullptr);
+      if (!client) std::this_thread::sleep_for(100ms);
+    }
+    if (!client) {
+      std::printf("the JACK server did not come up\n");
+      kill(jackd, SIGTERM);
+      waitpid(jackd, nullptr, 0);
+      return 1;
+    }
+    Keys keys;
+    keys.out = jack_port_register(client, "out", JACK_DEFAULT_MIDI_TYPE, JackPortIsOutput, 0);
+    jack_set_process_callback(client, &Keys::process, &keys);
+    long received = 0;
+    try {
+      hamiltone::app::MidiInput input("jack");
+      input.openVirtualPort("hamiltone-in");
+      if (!keys.out || jack_activate(client) != 0 ||
+          jack_connect(client, jack_port_name(keys.out), "hamiltone:hamiltone-in") != 0) {
+        std::printf("cannot connect the keys to the player's input\n");
+        ++failures;
+      }
+      keys.playing.store(true);
+      hamiltone::app::StampedMessage messages[256];
+      auto drain = [&] {
+        for (size_t n; (n = input.queue().pop(messages, 256)) > 0;)
+          received += static_cast<long>(n);
+      };
+      const auto end = std::chrono::steady_clock::now() + 2s;
+      while (std::chrono::steady_clock::now() < end) {
+        drain();
+        std::this_thread::sleep_for(5ms);
+      }
+      keys.playing.store(false);
+      std::this_thread::sleep_for(50ms);  // the last periods' events
+      drain();
+      std::printf("%ld events written, %ld received, %ld dropped\n", keys.written.load(), received,
+                  input.dropped());
+      if (received < 100 || received != keys.written.load() || input.dropped() != 0) ++failures;
+      input.close();
+    } catch (const hamiltone::app::MidiError& e) {
+      std::printf("%s\n", e.what());
+      ++failures;
+    }
+    jack_client_close(client);
+  }
+  kill(jackd, SIGTERM);
+  waitpid(jackd, nullptr, 0);
+  std::printf("%s\n", failures ? "FAILED" : "passed");
+  return failures ? 1 : 0;
+}
