@@ -305,33 +305,27 @@ int play(const PlayArguments& a) {
         s, double(now.tv_sec - started.tv_sec) + 1e-9 * double(now.tv_nsec - started.tv_nsec));
     if (!limitLine.empty())
       std::fprintf(stderr, "%shamiltone-play: %s\n", status ? "\n" : "", limitLine.c_str());
-    // The keyboard's port, once a second: unplugged, or its program gone.
-    if (++polls % 4 == 0 && !midi.portName().empty() && midi.portPresent() == portGone) {
-      portGone = !portGone;
-      if (portGone)
+    // The keyboard's port, once a second: unplugged, or its program gone; back, or (on JACK)
+    // gone and back between two checks, its connection gone with its old port.
+    if (++polls % 4 == 0 && !midi.portName().empty()) {
+      const bool present = midi.portPresent();
+      if (!portGone && !present) {
+        portGone = true;
         std::fprintf(stderr,
                      "%shamiltone-play: warning: the MIDI input port \"%s\" is gone, so no MIDI "
                      "input is connected; MIDI input ports now: %s; it is connected again when it "
                      "comes back, or restart with --midi-port N to choose another\n",
                      status ? "\n" : "", midi.portName().c_str(), portList(midi.ports()).c_str());
-      else
+      } else if (present && (portGone || midi.portReturned())) {
+        const char* how = portGone ? "is back: connected" : "went and came back: connected again";
         try {
           midi.reconnect();
-          std::fprintf(stderr, "%shamiltone-play: the MIDI input port \"%s\" is back: connected\n",
-                       status ? "\n" : "", midi.portName().c_str());
+          portGone = false;
+          std::fprintf(stderr, "%shamiltone-play: the MIDI input port \"%s\" %s\n",
+                       status ? "\n" : "", midi.portName().c_str(), how);
         } catch (const MidiError&) {
           portGone = true;  // tried again in a second
         }
-    } else if (polls % 4 == 0 && !portGone && midi.portReturned()) {
-      // Unplugged and plugged in again between two polls: its connection went with the old port.
-      try {
-        midi.reconnect();
-        std::fprintf(stderr,
-                     "%shamiltone-play: the MIDI input port \"%s\" went and came back: connected "
-                     "again\n",
-                     status ? "\n" : "", midi.portName().c_str());
-      } catch (const MidiError&) {
-        portGone = true;  // gone again: the check above connects it when it is back
       }
     }
     // A failed recording is said at once, on a line of its own; the sound plays on.

@@ -114,6 +114,13 @@ class JackPlay : public ::testing::Test {
     fs::remove_all(dir_);
   }
 
+  // This process a client of the server too, as the tests' children are, until the test ends: for
+  // the libjack clients a test makes itself.
+  void joinServer() {
+    joined_.emplace("JACK_DEFAULT_SERVER", server_);
+    noStart_.emplace("JACK_NO_START_SERVER", "1");
+  }
+
   // Players and senders before the server they are clients of.
   void stopAll() {
     sender_.reset();
@@ -328,6 +335,7 @@ class JackPlay : public ::testing::Test {
   fs::path dir_;
   std::vector<std::string> env_;
   std::optional<Child> jackd_, player_, sender_;
+  std::optional<hamiltone::testing::ScopedEnvironment> joined_, noStart_;  // joinServer()
 };
 
 // JACK tells every client of every xrun in its graph, so the player's underruns are the server's.
@@ -628,9 +636,7 @@ TEST_F(JackPlay, TheMidiInputClosesWhileTheGraphChanges) {
   if (!onPath("jackd") || !onPath("jack_lsp"))
     GTEST_SKIP() << "jackd (Debian's jackd2) is not installed";
   ASSERT_NO_FATAL_FAILURE(startServer(false));
-  // This process a client of that server, as the tests' children are, until the test ends.
-  const hamiltone::testing::ScopedEnvironment server("JACK_DEFAULT_SERVER", server_),
-      noStart("JACK_NO_START_SERVER", "1");
+  joinServer();
   const std::string ours = "hamiltone:hamiltone-in";
   {
     hamiltone::app::MidiInput input("jack");
@@ -725,8 +731,7 @@ TEST_F(JackPlay, ConnectsAgainToAKeyboardRepluggedBetweenTwoPolls) {
   if (!onPath("jackd") || !onPath("jack_lsp"))
     GTEST_SKIP() << "jackd (Debian's jackd2) is not installed";
   ASSERT_NO_FATAL_FAILURE(startServer(false));
-  const hamiltone::testing::ScopedEnvironment server("JACK_DEFAULT_SERVER", server_),
-      noStart("JACK_NO_START_SERVER", "1");
+  joinServer();
   const std::unique_ptr<jack_client_t, int (*)(jack_client_t*)> client(
       jack_client_open("fastkeys", JackNoStartServer, nullptr), &jack_client_close);
   jack_client_t* keys = client.get();

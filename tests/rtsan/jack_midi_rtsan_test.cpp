@@ -23,6 +23,7 @@
 #include <thread>
 
 #include "midi_input.h"
+#include "support/child_process.h"
 
 namespace {
 
@@ -56,16 +57,11 @@ struct Keys {
   }
 };
 
-bool onPath(const char* program) {
-  const std::string command = std::string("command -v ") + program + " >/dev/null 2>&1";
-  return std::system(command.c_str()) == 0;
-}
-
 }  // namespace
 
 int main() {
   using namespace std::chrono_literals;
-  if (!onPath("jackd")) {
+  if (!hamiltone::testing::onPath("jackd")) {
     // CI installs it (scripts/install-deps.sh): there its absence is a failure, not a skip.
     const char* ci = std::getenv("CI");
     std::printf("jackd (Debian's jackd2) is not installed: %s\n",
