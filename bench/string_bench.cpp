@@ -45,7 +45,6 @@ constexpr Note kNotes[] = {{21, "A0"}, {48, "C3"}, {84, "C6"}};
 constexpr GridRule kGrids[] = {GridRule::twoGrid, GridRule::transverse, GridRule::longitudinal};
 constexpr int kOversampling[] = {1, 4};
 
-
 std::string voiceName(const Note& note, GridRule grid, int oversampling, bool lossless) {
   return std::string("StringVoice/") + note.name + "_" + std::to_string(note.midi) + "/" +
          gridRuleName(grid) + "/os:" + std::to_string(oversampling) + (lossless ? "/lossless" : "");
@@ -56,7 +55,15 @@ struct VoiceCase {
   GridRule grid;
   int oversampling;
   bool lossless;
+  int tail = -1;  // −1: re-struck (above); 0, 1: in the tail, the linear tail off or on (below)
 };
+
+// The tail: struck once at kTailVelocity and left to ring until the default threshold takes the
+// string linear (found on a voice of its own, the same for both cases), then timed for
+// kTailBlocks as it decays on — against the same string kept geometric (scheme.linear_below = 0).
+constexpr double kTailVelocity = 0.3;
+constexpr int kTailBlocks = 1500;  // 2 s of audio
+constexpr double kTailLatestS = 30.0;
 
 // One iteration is one block of 64 samples, stereo, as an audio callback would ask for it.
 void processVoice(benchmark::State& state, VoiceCase c) {
@@ -65,6 +72,7 @@ void processVoice(benchmark::State& state, VoiceCase c) {
   patch.grid = c.grid;
   patch.oversampling = c.oversampling;
   if (c.lossless) patch.t60Low = patch.t60High = INFINITY;
+  if (c.tail == 0) patch.linearBelow = 0.0;
   StringVoice voice;
   try {
     voice.prepare(patch, c.note.midi, kSampleRate);
@@ -78,10 +86,27 @@ void processVoice(benchmark::State& state, VoiceCase c) {
     return;
   }
   std::array<float, kBlock> left{}, right{};
-  voice.noteOn(kVelocity);
+  const bool inTail = c.tail >= 0;
+  voice.noteOn(inTail ? kTailVelocity : kVelocity);
+  if (inTail) {
+    StringPatch probePatch = patch;
+    probePatch.linearBelow = StringPatch{}.linearBelow;
+    StringVoice probe;
+    probe.prepare(probePatch, c.note.midi, kSampleRate);
+    probe.noteOn(kTailVelocity);
+    long start = 0;
+    for (; !probe.linear() && start < std::lround(kTailLatestS * kSampleRate / kBlock); ++start)
+      probe.process(left, right);
+    for (long n = 0; n < start; ++n) voice.process(left, right);
+    if (voice.linear() != (c.tail == 1)) {
+      state.SkipWithError("the string is not (or is) in its linear tail where the case says");
+      return;
+    }
+    state.counters["tail_from_s"] = static_cast<double>(start * kBlock) / kSampleRate;
+  }
   int blocks = 0;
   for (auto _ : state) {
-    if (!c.lossless && ++blocks == kRestrikeBlocks) {
+    if (!c.lossless && !inTail && ++blocks == kRestrikeBlocks) {
       voice.noteOn(kVelocity);
       blocks = 0;
     }
@@ -171,6 +196,14 @@ SchemeGrids registerBenchmarks() {
                                      VoiceCase{note, grid, os, false})
             ->UseRealTime()
             ->Unit(benchmark::kMicrosecond);
+  for (const Note& note : kNotes)
+    for (int tail : {0, 1})
+      benchmark::RegisterBenchmark(
+          (voiceName(note, GridRule::twoGrid, 1, false) + (tail ? "/tail" : "/tail_off")).c_str(),
+          &processVoice, VoiceCase{note, GridRule::twoGrid, 1, false, tail})
+          ->Iterations(kTailBlocks)
+          ->UseRealTime()
+          ->Unit(benchmark::kMicrosecond);
   benchmark::RegisterBenchmark(voiceName(kNotes[1], GridRule::transverse, 1, true).c_str(),
                                &processVoice, VoiceCase{kNotes[1], GridRule::transverse, 1, true})
       ->UseRealTime()
@@ -215,10 +248,10 @@ void printVoices(const RecordingReporter& reporter) {
     }
     const double nsPerSample = r->seconds / kBlock * 1e9;
     const double unknowns = r->counters.at("unknowns").value;
-    std::printf("%-4s %-12s %3d %-9s %8.0f %9.0f %10.1f %8.2f %16.3f\n", note.name, gridRuleName(grid),
-                os, lossless ? "lossless" : "patch", r->counters.at("segments").value, unknowns,
-                nsPerSample, 100.0 * nsPerSample * kSampleRate / 1e9,
-                nsPerSample / (os * unknowns));
+    std::printf("%-4s %-12s %3d %-9s %8.0f %9.0f %10.1f %8.2f %16.3f\n", note.name,
+                gridRuleName(grid), os, lossless ? "lossless" : "patch",
+                r->counters.at("segments").value, unknowns, nsPerSample,
+                100.0 * nsPerSample * kSampleRate / 1e9, nsPerSample / (os * unknowns));
   };
   for (const Note& note : kNotes)
     for (GridRule grid : kGrids)
@@ -239,6 +272,18 @@ void printVoices(const RecordingReporter& reporter) {
     const double ratio = two->seconds / one->seconds;
     std::printf("Goal: %s voice, two-grid / transverse cost <= 0.7: %.2f, %s\n", note.name, ratio,
                 verdict(ratio <= 0.7));
+  }
+  // The linear tail against the same string kept geometric, from the same moment.
+  for (const Note& note : kNotes) {
+    const std::string base = voiceName(note, GridRule::twoGrid, 1, false);
+    const auto* on = reporter.find(base + "/tail");
+    const auto* off = reporter.find(base + "/tail_off");
+    if (on == nullptr || off == nullptr) continue;
+    std::printf(
+        "%s two-grid voice in its linear tail (from %.1f s after a strike at %.1f): %.0f ns per "
+        "sample against %.0f kept geometric, %.2f of the cost\n",
+        note.name, on->counters.at("tail_from_s").value, kTailVelocity, on->seconds / kBlock * 1e9,
+        off->seconds / kBlock * 1e9, on->seconds / off->seconds);
   }
 }
 

@@ -175,6 +175,7 @@ int run(const Options& o) {
       patches[c].grid = kConfigs[c].grid;
       patches[c].oversampling = kConfigs[c].oversampling;
       patches[c].channels = 1;
+      if (!kConfigs[c].cheap) patches[c].linearBelow = 0.0;  // the reference geometric throughout
       voices[c].prepare(patches[c], midi, kSampleRate);
       while (!kConfigs[c].cheap && patches[c].oversampling < kMaxReference &&
              voices[c].segments() < 2 * voices[1].segments()) {  // [1]: the two grids

@@ -39,22 +39,28 @@ void chord(benchmark::State& state) {
 // Every 6th key from A0 to C8 (15 keys, all unison strings on their bridges) struck together and
 // held: the time per block divided by the keys is the cost of an average grand-piano key (ns per
 // sample of audio). The body is off: its cost is the board's and every key's sympathetic strings,
-// shared by the keys and the same on both grid rules (hamiltone_bench_body measures it).
+// shared by the keys and the same on both grid rules (hamiltone_bench_body measures it). tail:0
+// turns the linear tail off (scheme.linear_below = 0), which only the two grids take: the rules
+// compared geometric throughout.
 constexpr const char* kGridRules[] = {"two-grid", "transverse"};
 
 void keyboard(benchmark::State& state) {
   const char* rule = kGridRules[state.range(0)];
-  const Instrument piano =
-      loadPreset(HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml",
-                 {.overrides = {{"scheme.grid_rule", rule}, {"body.enabled", "false"}}});
+  const bool tail = state.range(1) != 0;
+  PresetOptions options{.overrides = {{"scheme.grid_rule", rule}, {"body.enabled", "false"}}};
+  if (!tail) options.overrides.push_back({"scheme.linear_below", "0"});
+  const Instrument piano = loadPreset(HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml", options);
   playHeldKeys(state, piano, everyNthKey(piano, 6), 256, kRestrikeS);
-  state.SetLabel(rule);
+  state.SetLabel(std::string(rule) + (tail ? "" : ", no tail"));
 }
 
 }  // namespace
 }  // namespace hamiltone
 
-BENCHMARK(hamiltone::keyboard)->ArgName("rule")->DenseRange(0, 1)->Unit(benchmark::kMillisecond);
+BENCHMARK(hamiltone::keyboard)
+    ->ArgNames({"rule", "tail"})
+    ->ArgsProduct({{0, 1}, {1, 0}})
+    ->Unit(benchmark::kMillisecond);
 
 BENCHMARK(hamiltone::chord)
     ->ArgNames({"voices", "block"})
@@ -92,11 +98,14 @@ int main(int argc, char** argv) {
   benchmark::RunSpecifiedBenchmarks(&reporter);
   const int largest = reporter.largest;
   auto& cost = reporter.keyCost;
-  if (cost.count("two-grid") && cost.count("transverse"))
-    std::printf(
-        "\ngrand-piano key (no body), every 6th from A0: two-grid %.0f ns per sample, "
-        "transverse %.0f (ratio %.2f; goal <= 0.7)\n",
-        1e9 * cost["two-grid"], 1e9 * cost["transverse"], cost["two-grid"] / cost["transverse"]);
+  for (const char* tail : {"", ", no tail"}) {
+    const std::string two = std::string("two-grid") + tail, one = std::string("transverse") + tail;
+    if (cost.count(two) && cost.count(one))
+      std::printf(
+          "\ngrand-piano key (no body), every 6th from A0%s: two-grid %.0f ns per sample, "
+          "transverse %.0f (ratio %.2f; goal <= 0.7)\n",
+          tail, 1e9 * cost[two], 1e9 * cost[one], cost[two] / cost[one]);
+  }
   std::printf(
       "\nlargest grand-piano chord (keys from C3) rendered faster than real time on one "
       "core: %d keys (goal: 32)\n",

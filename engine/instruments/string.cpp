@@ -62,9 +62,9 @@ NonlinearString::NonlinearString(const StringPhysics& p, StringGrid grid)
 void NonlinearString::applyStiffness(const Vector& q, Vector& out) const {
   const Eigen::Index n = segments_ - 1, nv = grid_.longitudinal - 1;
   const double invH2 = 1.0 / (h_ * h_);
-  if (nv > 0)
-    kernels_->secondDifference(q.data() + n, out.data() + n, nv,
-                               -physics_.tension / hv_);  // −T0 h_v D2 v
+  // −T0 h_v D2 v; the linear string's −EA h_v D2 v
+  const double vTension = linearised_ ? physics_.young * physics_.area : physics_.tension;
+  if (nv > 0) kernels_->secondDifference(q.data() + n, out.data() + n, nv, -vTension / hv_);
   const double t = tensionScale_ * physics_.tension * h_;
   if (physics_.inertia == 0.0) {
     kernels_->secondDifference(q.data(), out.data(), n, -t * invH2);  // −βT0 h D2 u
@@ -150,6 +150,21 @@ double NonlinearString::maxStableStep(double sigma1) const {
   if (grid_.longitudinal < 2) return u;
   return std::min(u, hamiltone::maxStableStep(longitudinalEigenvalue(grid_.longitudinal - 1),
                                               longitudinalLossTop(), sigma1));
+}
+
+double NonlinearString::linearisedMaxStableStep(double sigma1) const {
+  const double u = hamiltone::maxStableStep(stiffnessEigenvalueMax(), transverseLossTop(), sigma1);
+  if (grid_.longitudinal < 2) return u;
+  const double ea = physics_.young * physics_.area / physics_.tension;  // EA/T0
+  return std::min(u, hamiltone::maxStableStep(ea * longitudinalEigenvalue(grid_.longitudinal - 1),
+                                              longitudinalLossTop(), sigma1));
+}
+
+double NonlinearString::linearEndTension(const Vector& q) const {
+  const int mv = grid_.longitudinal;
+  if (mv < 2) return 0.0;
+  const double etaLast = -q[segments_ - 1 + mv - 2] / hv_;  // v_M = 0
+  return physics_.young * physics_.area * etaLast;
 }
 
 void NonlinearString::applyLossOperator(const Vector& a, const Vector& b, Vector& out) const {

@@ -98,6 +98,20 @@ class NonlinearString {
   void setTensionScale(double scale) { tensionScale_ = std::clamp(scale, 0.0, tensionScaleMax_); }
   double tensionScale() const { return tensionScale_; }
 
+  // The linear string (docs/string-grids.md, "The linear tail"): V' replaced by its quadratic part
+  // at rest, (EA − T0)/2 Σ_J h_v η_J² — the longitudinal wave's stiffness beyond T0 — taken into
+  // K, whose v block then holds EA: −EA h_v D2 v. What it leaves out is the tension modulation, the
+  // strain u's slopes add to each cell (Z_J/2). A scheme that drops V' (SavScheme::dropPart) and
+  // takes K again (stiffnessChanged) steps the linear string; the longitudinal wave keeps its
+  // speed.
+  void setLinearised(bool on) noexcept { linearised_ = on; }
+  bool linearised() const { return linearised_; }
+  // The bound (44) for the linear string: v's block at EA. Where v's grid does not resolve the
+  // longitudinal wave (c_L k > h_v, the transverse grid) it is shorter than a step there.
+  double linearisedMaxStableStep(double sigma1) const;
+  // ΔT at the far end of the linear string at q: EA η_M (0 with one coarse cell, Mv = 1).
+  double linearEndTension(const Vector& q) const;
+
   // Eigenvalue m = 1 … M−1 of M⁻¹K on u: (βT0/ρA)(4/h²) s² + (EI/ρA)(16/h⁴) s⁴, s = sin(mπ/2M).
   double transverseEigenvalue(int m) const;
   double transverseEigenvalue(int m, double scale) const;  // at β = scale
@@ -120,6 +134,7 @@ class NonlinearString {
   double h_, hv_;         // h_u, h_v
   Vector inverseMass_;
   double tensionScale_ = 1.0, tensionScaleMax_ = 1.0;
+  bool linearised_ = false;
   LossWeights lossWeights_;
   mutable double endTension_ = 0.0;
   // Work of the stencils and the gradient: per fine segment (size Mu; work3_ holds u padded with

@@ -179,6 +179,29 @@ HAMILTONE_TARGET double savUpdate(long n, const double* g, const double* q, cons
   return savUpdateOf<false, false>(n, g, q, qm, minv, kq, x, xScale, down, kk, c, invUp, qp);
 }
 
+template <bool stiff, bool extra>
+HAMILTONE_TARGET void linearUpdateOf(long n, const double* q, const double* qm, const double* minv,
+                                     const double* kq, const double* x, double xScale, double down,
+                                     double kk, double invUp, double* qp) {
+#pragma omp simd
+  for (long i = 0; i < n; ++i) {
+    double b = 2.0 * q[i] - down * qm[i];
+    if constexpr (stiff) b -= kk * (minv[i] * kq[i]);
+    if constexpr (extra) b -= minv[i] * (xScale * x[i]);
+    qp[i] = b * invUp;
+  }
+}
+
+HAMILTONE_TARGET void linearUpdate(long n, const double* q, const double* qm, const double* minv,
+                                   const double* kq, const double* x, double xScale, double down,
+                                   double kk, double invUp, double* qp) {
+  if (kq && x)
+    return linearUpdateOf<true, true>(n, q, qm, minv, kq, x, xScale, down, kk, invUp, qp);
+  if (kq) return linearUpdateOf<true, false>(n, q, qm, minv, kq, x, xScale, down, kk, invUp, qp);
+  if (x) return linearUpdateOf<false, true>(n, q, qm, minv, kq, x, xScale, down, kk, invUp, qp);
+  linearUpdateOf<false, false>(n, q, qm, minv, kq, x, xScale, down, kk, invUp, qp);
+}
+
 // One vector register of doubles (GCC's vector extension, so that the product below is vectorised
 // along the rows as written, whatever the compiler's cost model).
 typedef double Lanes __attribute__((vector_size(kLanes * sizeof(double))));
@@ -257,6 +280,7 @@ extern const Kernels kernels{.isa = HAMILTONE_KERNEL_ISA,
                              .secondDifferenceOfDifference = secondDifferenceOfDifference,
                              .savDots = savDots,
                              .savUpdate = savUpdate,
+                             .linearUpdate = linearUpdate,
                              .matrixProduct = matrixProduct,
                              .gridLaplacian = gridLaplacian,
                              .gridCells = gridCells,

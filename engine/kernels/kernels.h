@@ -54,6 +54,11 @@ struct Kernels {
   double (*savUpdate)(long n, const double* g, const double* q, const double* qm,
                       const double* minv, const double* kq, const double* x, double xScale,
                       double down, double kk, double c, double invUp, double* qp);
+  // The same with no part loaded (g = 0: the linear string, sav.h): qp_i = (2q_i − down qm_i −
+  // kk M⁻¹kq_i − M⁻¹x_i) invUp.
+  void (*linearUpdate)(long n, const double* q, const double* qm, const double* minv,
+                       const double* kq, const double* x, double xScale, double down, double kk,
+                       double invUp, double* qp);
 
   // The plate's loops. C = A B, column-major, A m × k (leading dimension lda), B k × n read as
   // b_pj = b[stepB p + ldb j], C m × n; m a multiple of 8. Each c_ij is Σ_p a_ip b_pj summed in

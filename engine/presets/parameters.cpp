@@ -616,6 +616,19 @@ constexpr Parameter kTable[] = {
      .doc = "two-grid: u's grid is sized for this multiple of T0. Stability needs only T0; a "
             "struck string's tension rises above it, and a grid at the T0 bound then glides at "
             "half the rate. A larger margin is coarser and cheaper (fewer high partials)."},
+    {.name = "scheme.linear_below",
+     .min = 0,
+     .max = 1e-3,
+     .defaultText = "1e-4",
+     .model = kString,
+     .doc = "The linear tail: once the hammer is back and the tension modulation's bound from "
+            "the string's energy H (ΔT/T0 <= EA H / (T0² L)) is under this, the string is "
+            "stepped linear — V' dropped for its quadratic part, the longitudinal "
+            "wave kept at its speed — at 0.4–0.5 of the cost; a strike makes it geometric "
+            "again. The pitch is then off by at most 866 × this cents (1e-4: 0.087 cents; measured "
+            "half that). 0: "
+            "never (the research configuration). two-grid and longitudinal only: on the "
+            "transverse grid the linear v would not be stable, and the string stays geometric."},
     {.name = "scheme.epsilon_J",
      .unit = "J",
      .min = 0,

@@ -29,6 +29,7 @@ constexpr VoiceField kStringFields[] = {
     {"guard_energy_multiple", "scheme.guard_energy_multiple"},
     {"epsilon_j", "scheme.epsilon_J"},
     {"tension_margin", "scheme.tension_margin"},
+    {"linear_below", "scheme.linear_below"},
     {"bend_range_semitones", "bend_range_semitones"},
     {"tension scale range", "bend_range_semitones", true},
     {"t60_low_s", "loss.t60_low_s"},
@@ -70,6 +71,7 @@ void buildStringKeys(const PresetValues& values, Instrument& instrument) {
                                        : GridRule::longitudinal;
   common.gridFactor = number("scheme.grid_factor");
   common.tensionMargin = number("scheme.tension_margin");
+  common.linearBelow = number("scheme.linear_below");
   common.oversampling = static_cast<int>(number("scheme.oversampling"));
   if (values.setting("scheme.epsilon_J")) common.epsilon = number("scheme.epsilon_J");
   common.t60HighHz = number("loss.t60_high_Hz");

@@ -158,6 +158,23 @@ class SavScheme {
     psi_[part] = std::sqrt(2.0 * (quadratisedPotential(part, next_) + params_.epsilon));
   }
 
+  // Drops part j's V'_j from the steps — a string gone linear, whose caller has put V''s quadratic
+  // part at rest into K (NonlinearString::setLinearised) and takes K q again (stiffnessChanged()):
+  // ∇V'_j is no longer taken and ψ_j is set to sqrt(2ε), so that its ½ψ_j² − ε is 0. The energy
+  // changes by what ψ_j held, which energy() then reports. With no part loaded and no damper, a
+  // step is then one pass: Störmer–Verlet with the loss (49). restorePart() takes V'_j back, ψ_j
+  // from V'_j(q^{n+½}) as resetPsi().
+  void dropPart(int part) noexcept requires(form == SavForm::split) {
+    dropped_[part] = true;
+    grads_[part].setZero();
+    psi_[part] = std::sqrt(2.0 * params_.epsilon);
+  }
+  void restorePart(int part) noexcept requires(form == SavForm::split) {
+    dropped_[part] = false;
+    resetPsi(part);
+  }
+  bool dropped(int part) const { return dropped_[part]; }
+
   // The instruction set of the one-part passes (default: selectedKernels()).
   void setKernels(const Kernels& kernels) noexcept { kernels_ = &kernels; }
 
@@ -203,7 +220,7 @@ class SavScheme {
       s[j] = shifted > 0.0 ? 1.0 / std::sqrt(2.0 * shifted) : 0.0;
       h[j] = 0.5 * k * s[j];
       g[j] = grads_[j].data();
-      if (potential != 0.0 || parts == 1) {
+      if (!dropped_[j] && (potential != 0.0 || parts == 1)) {
         ++loaded;
         onlyLoaded = j;
       }
@@ -228,6 +245,10 @@ class SavScheme {
       }
     }
 
+    if (loaded == 0) {
+      stepLinear<lossy>(cq, cqScale);
+      return;
+    }
     if (onePass && !damped_) {
       stepOnePart<lossy>(onlyLoaded, s[onlyLoaded], h[onlyLoaded], cq, cqScale, g[onlyLoaded]);
       return;
@@ -428,6 +449,37 @@ class SavScheme {
     finishStep<lossy>();
   }
 
+  // The step with no part loaded (V' dropped, or at rest, and the hammer off the string):
+  // ∇V' = 0 leaves (40) b / (1+σ0k), one pass; ψ stays as it is. A damped coordinate takes
+  // b' / (1+σ0k + d) (D1).
+  template <bool lossy>
+  void stepLinear(const double* cq, double cqScale) noexcept {
+    const StepView v = view();
+    const double invUp = 1.0 / v.up;
+    const double* kq = splitK ? kq_.data() : nullptr;
+    kernels_->linearUpdate(v.n, v.q, v.qm, v.minv, kq, lossy ? cq : nullptr, cqScale, v.down, v.kk,
+                           invUp, v.qp);
+    for (int p = 0; p < kPointForces; ++p)
+      v.qp[pointIndex_[p]] += v.kk * v.minv[pointIndex_[p]] * pointForce_[p] * invUp;
+    for (int m = 0; damped_ && m < kPointDampers; ++m) {
+      const double d = damperD_[m];
+      if (d == 0.0) continue;
+      const Eigen::Index i = damperIndex_[m];
+      double b = 2.0 * v.q[i] - v.down * v.qm[i] + d * v.qm[i];
+      if constexpr (splitK) b -= v.kk * (v.minv[i] * kq[i]);
+      if constexpr (lossy) b -= cqScale * v.minv[i] * cq[i];
+      for (int p = 0; p < kPointForces; ++p)
+        if (pointIndex_[p] == i) b += v.kk * v.minv[i] * pointForce_[p];
+      const double x = b / (v.up + d);
+      v.qp[i] = x;
+      if (params_.trackDissipation)  // r/(4k) Δ², r = 2d/(k M⁻¹_ii)  (D1)
+        dissipated_ += d / (2.0 * v.k * v.k * v.minv[i]) * (x - v.qm[i]) * (x - v.qm[i]);
+    }
+    for (int p = 0; p < kPointForces; ++p)
+      supplied_ += 0.5 * pointForce_[p] * (v.qp[pointIndex_[p]] - v.qm[pointIndex_[p]]);
+    finishStep<lossy>();
+  }
+
   // (44): k <= 2 / sqrt(λmax(M^-½ K M^-½)), else the energy (41) has no sign and no bound;
   // with σ1 > 0 the bound of maxStableStep.
   void checkStabilityBound() const {
@@ -463,6 +515,7 @@ class SavScheme {
     if constexpr (splitK) {
       if (part == 0) system_.applyStiffness(curr_, kq_);
     }
+    if (dropped_[part]) return 0.0;
     if constexpr (partitioned) return system_.partGradient(part, curr_, grads_[part]);
     return system_.splitGradient(curr_, grads_[0]);
   }
@@ -470,11 +523,12 @@ class SavScheme {
   S system_;
   StepParameters params_;
   LinearLoss<S> loss_;
-  Vector prev_, curr_, next_;        // q^n, q^{n+1}, workspace; rotated by swapping
-  std::array<Vector, parts> grads_;  // ∇V'_j (∇V for (27)) at the newest level a step used
-  Vector kq_;                        // and K q there
-  std::array<double, parts> psi_{};  // ψ_j^{n+½}
-  Vector force_;                     // external force f, N per coordinate
+  Vector prev_, curr_, next_;          // q^n, q^{n+1}, workspace; rotated by swapping
+  std::array<Vector, parts> grads_;    // ∇V'_j (∇V for (27)) at the newest level a step used
+  Vector kq_;                          // and K q there
+  std::array<double, parts> psi_{};    // ψ_j^{n+½}
+  std::array<bool, parts> dropped_{};  // dropPart()
+  Vector force_;                       // external force f, N per coordinate
   Vector extra_;  // 2σ1k C(q^n − q^{n−1}) − k² f: what b loses through M⁻¹
   bool forced_ = false;
   std::array<Eigen::Index, kPointForces> pointIndex_{};

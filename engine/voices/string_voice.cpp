@@ -22,6 +22,7 @@ constexpr double kStrikeGap = 1e-4;            // m: the hammer starts 0.1 mm be
 constexpr double kParkedAt = -0.02;            // m: where the back-check holds it
 constexpr double kCheckDelay = 1e-3;           // s out of contact, moving away, before the catch
 constexpr double kCheckGap = 1e-3;             // m below the string, at least, when caught
+constexpr long kLinearCheckSteps = 256;        // the linear tail's check, every this many steps
 
 void require(bool ok, const char* field, double value, const std::string& valid) {
   if (!ok)
@@ -324,6 +325,12 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
                                          }) + why);
   }
   string.setLossWeights(schemeSide.weights);
+  require(std::isfinite(patch.linearBelow) && patch.linearBelow >= 0.0 && patch.linearBelow <= 1e-3,
+          "linear_below", patch.linearBelow,
+          "between 0 (never linear) and 1e-3 (a relative tension change; the pitch is then off by "
+          "at most 866 × it cents)");
+  const bool linearisable =
+      patch.linearBelow > 0.0 && k <= string.linearisedMaxStableStep(schemeSide.sigma1);
   const HammeredString system(std::move(string), patch.hammer);
   InitialState rest{Vector::Zero(system.size()), Vector::Zero(system.size())};
   rest.q[system.hammerIndex()] = kParkedAt;
@@ -348,6 +355,7 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
   bendOffset_ = system.string().transverseEigenvalue(1, 0.0);
   bendSlope_ = system.string().transverseEigenvalue(1, 1.0) - bendOffset_;
   bend_ = 0.0;
+  linearisable_ = linearisable;
   scheme_ = std::move(scheme);
   atRest_ = std::move(atRest);
   for (int c = 0; c < 2; ++c) decimators_[c] = std::move(decimators[c]);
@@ -361,7 +369,7 @@ void StringVoice::reset() noexcept {
   injected_ = caught_ = 0.0;
   separatedSteps_ = 0;
   quiet_.reset();
-  active_ = struck_ = false;
+  active_ = struck_ = linear_ = false;  // the copy's string is geometric
   parked_ = true;
   applyBend();  // the copy brought back β = 1
 }
@@ -394,6 +402,7 @@ void StringVoice::noteOn(double velocity) noexcept {
   // A freed voice starts from rest: what a decayed string keeps on the transverse grid (a static
   // longitudinal stretch the SAV can leave, see docs/string-grids.md) would detune the next note.
   if (!active_) reset();
+  if (linear_) setLinear(false);  // the strike's tension modulation, from its first step
   const double v = velocity >= 0.0 ? std::min(velocity, 1.0) : 0.0;  // NaN too
   const double speed = patch_.velocityMin + (patch_.velocityMax - patch_.velocityMin) *
                                                 std::pow(v, patch_.velocityCurve);
@@ -494,9 +503,42 @@ double StringVoice::pickup(const Vector& q, const Vector& qNext, double position
   return (at(qNext) - at(q)) / k_;
 }
 
+// The linear tail. The tension modulation, ΔT/T0 = (EA/2T0) Z̄ with Z̄ = (1/L) ∫ u_x² the mean
+// square slope, is bounded at every instant by the energy: H >= ½ βT0 L Z̄ (the rest of H —
+// kinetic, bending, v, the hammer parked at rest — is >= 0), so ΔT/T0 <= EA H / (βT0² L). Once
+// the hammer is parked and that bound has fallen under linearBelow, V' is dropped for its
+// quadratic part at rest (NonlinearString::setLinearised), and a step is Störmer–Verlet on the
+// linear string, one pass; over twice linearBelow again (energy the bridge brings from a sibling
+// string) it is geometric again. Each switch changes the energy by what ψ held less the quadratic
+// part, counted with what the strikes put in. Checked at fixed step counts, so the output does not
+// depend on the block size.
+void StringVoice::checkLinear() noexcept {
+  const NonlinearString& string = scheme_->system().string();
+  const StringPhysics& p = string.physics();
+  const double modulation =
+      p.young * p.area * energy() / (string.tensionScale() * p.tension * p.tension * p.length);
+  if (!linear_ && parked_ && modulation < patch_.linearBelow)
+    setLinear(true);
+  else if (linear_ && modulation > 2.0 * patch_.linearBelow)
+    setLinear(false);
+}
+
+void StringVoice::setLinear(bool on) noexcept {
+  const double before = energy();
+  scheme_->system().string().setLinearised(on);
+  if (on)
+    scheme_->dropPart(0);
+  else
+    scheme_->restorePart(0);
+  scheme_->stiffnessChanged();
+  injected_ += energy() - before;
+  linear_ = on;
+}
+
 bool StringVoice::stepAndPick(double out[2]) noexcept {
   scheme_->step();
   catchHammer();
+  if (linearisable_ && scheme_->stepIndex() % kLinearCheckSteps == 0) checkLinear();
   const Vector& q = scheme_->q();
   const Vector& qNext = scheme_->qNext();
   bool ready = false;

@@ -29,6 +29,11 @@ struct StringPatch {
   double gridFactor = 1.0;
   double tensionMargin = 1.5;  // two grids: u's grid sized for this multiple of T0 (SCHEMES §3b)
   int oversampling = 1;        // 1, 2, 4, 8, 16, 32 or 64
+  // The linear tail: once the hammer is parked and the tension modulation's bound from the energy
+  // (StringVoice::checkLinear) is under this, the string goes linear (V' dropped, its quadratic
+  // part kept); back over twice this, or at a strike, it is geometric again. 0: never. Only where
+  // v's grid resolves the longitudinal wave (the linear v must be stable).
+  double linearBelow = 1e-4;
   // Gauge shift ε, J; none: kEpsilonShare of the hardest strike's energy ½ M_H v_max² where v's
   // grid resolves the longitudinal wave, 0 where it does not (docs/string-grids.md).
   std::optional<double> epsilon;
@@ -128,7 +133,10 @@ class StringVoice {
   bool stepOnBridge(double w, double out[2]) noexcept;
   double pullOnBridge(double w) const noexcept { return coupling_.forceOnBridge(scheme_->q(), w); }
   // The string's tension change at its bridge end at q^n, N (NonlinearString::endTension()).
-  double endTension() const noexcept { return scheme_->system().string().endTension(); }
+  double endTension() const noexcept {
+    const NonlinearString& s = scheme_->system().string();
+    return linear_ ? s.linearEndTension(scheme_->q()) : s.endTension();
+  }
   const BridgeCoupling& coupling() const { return coupling_; }
   const StringPatch& patch() const { return patch_; }
   // The nodes of u (coordinates of q) under a felt damper; none with the uniform one or none.
@@ -137,8 +145,11 @@ class StringVoice {
   }
 
   bool active() const { return active_; }
-  double energy() const;                               // the scheme's H^{n+½} (ε excluded), J
-  double injectedEnergy() const { return injected_; }  // by the strikes and the bend's retensioning
+  bool linear() const { return linear_; }  // in its linear tail (linearBelow)
+  double energy() const;                   // the scheme's H^{n+½} (ε excluded), J
+  // By the strikes, the bend's retensioning and the linear tail's switches (V' against its
+  // quadratic part at rest, either sign).
+  double injectedEnergy() const { return injected_; }
   // Taken out by the back-check (the hammer's kinetic energy and its ψ residual). The string's
   // losses are not tallied on the audio path; with them off, energy() + removedEnergy() stays
   // injectedEnergy().
@@ -154,6 +165,8 @@ class StringVoice {
   void catchHammer() noexcept;
   void applyBend() noexcept;
   bool stepAndPick(double out[2]) noexcept;  // one scheme step; true when a sample is out
+  void checkLinear() noexcept;               // every kLinearCheckSteps steps
+  void setLinear(bool on) noexcept;
 
   StringPatch patch_;
   std::unique_ptr<SplitSav<HammeredString>> scheme_;
@@ -173,6 +186,7 @@ class StringVoice {
   int separatedSteps_ = 0;
   bool active_ = false, struck_ = false;
   bool parked_ = true;  // the back-check holds the hammer (until the next strike)
+  bool linearisable_ = false, linear_ = false;
 };
 
 }  // namespace hamiltone

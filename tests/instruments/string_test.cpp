@@ -106,6 +106,63 @@ TEST(NonlinearString, EndTensionIsHookesLawOfTheLastCell) {
   }
 }
 
+// The linear string (the linear tail): its K is the geometric K plus the Hessian of V' at rest —
+// only v's block, at EA − T0, since V' is quartic in u there — taken by central differences of
+// ∇V' at q = 0 (V' is smooth, so O(δ²) against roundoff ~1e-16 |∇V'|/δ: 1e-6 of the column's
+// largest entry). Its end tension is Hooke's EA η_M, which the geometric string's tends to at
+// small strain (the case of EndTensionIsHookesLawOfTheLastCell, with u moving too).
+TEST(NonlinearString, TheLinearStringTakesTheHessianOfVPrimeAtRestIntoK) {
+  for (const StringGrid grid : {StringGrid{24, 24}, StringGrid{24, 6}, StringGrid{24, 1}}) {
+    NonlinearString string(c3(), grid);
+    const Eigen::MatrixXd k =
+        matrixOf(string, [&](const Vector& e, Vector& out) { string.applyStiffness(e, out); });
+    string.setLinearised(true);
+    const Eigen::MatrixXd linear =
+        matrixOf(string, [&](const Vector& e, Vector& out) { string.applyStiffness(e, out); });
+    string.setLinearised(false);
+    const Eigen::Index n = string.size();
+    Eigen::MatrixXd hessian(n, n);
+    Vector plus(n), minus(n);
+    for (Eigen::Index j = 0; j < n; ++j) {
+      const double delta = 1e-6 * string.spacing();
+      Vector q = Vector::Zero(n);
+      q[j] = delta;
+      string.splitGradient(q, plus);
+      q[j] = -delta;
+      string.splitGradient(q, minus);
+      hessian.col(j) = (plus - minus) / (2.0 * delta);
+    }
+    const double scale = linear.cwiseAbs().maxCoeff();
+    EXPECT_LE((linear - k - hessian).cwiseAbs().maxCoeff(), 1e-6 * scale)
+        << "Mu = " << grid.transverse << ", Mv = " << grid.longitudinal;
+    EXPECT_LE(hessian.topLeftCorner(23, 23).cwiseAbs().maxCoeff(), 1e-9 * scale);
+  }
+  const StringPhysics p = c3();
+  const NonlinearString string(p, StringGrid{24, 6});
+  Vector q = 1e-6 * randomVector(string.size(), 1.0, 3);
+  q.head(string.transverseSize()) *= 1e-3;  // u's slopes' share is of second order
+  Vector grad(string.size());
+  string.splitGradient(q, grad);
+  EXPECT_NEAR(string.linearEndTension(q), string.endTension(),
+              1e-4 * std::abs(string.linearEndTension(q)));
+}
+
+// The linear string is stable where v's grid resolves the longitudinal wave at EA (h_v >= c_L k),
+// and not on the single grid at the transverse bound (c_L k / h ≈ 15 at 48 kHz): there the linear
+// tail is never taken.
+TEST(NonlinearString, TheLinearStringIsStableOnlyWhereVResolvesTheLongitudinalWave) {
+  const StringPhysics p = c3();
+  const double k = 1.0 / 48000.0;
+  const double cL = std::sqrt(p.young / p.density);
+  const int mv = static_cast<int>(std::floor(p.length / (1.05 * cL * k)));
+  const NonlinearString two(p, StringGrid{mv * 6, mv});
+  EXPECT_GE(two.linearisedMaxStableStep(0.0), k);
+  const int fine = gridSegments(p, GridRule::transverse, k, 0.0, kOffTheBound);
+  const NonlinearString single(p, fine);
+  EXPECT_GE(single.maxStableStep(0.0), k);
+  EXPECT_LT(single.linearisedMaxStableStep(0.0), 0.2 * k);
+}
+
 // Mv = 1 leaves no longitudinal unknown: V' = (EA − T0) L ε² / 2 with ε = S − 1, S = sqrt(1 + Z),
 // Z = (1/M) Σ ζ_l² the string's mean square slope, and the force on u is that of the extra tension
 // (EA − T0) ε along the string: ∂V'/∂ζ_l = h (EA − T0) ε ζ_l / S. To leading order ε = Z/2 =

@@ -208,6 +208,15 @@ TEST(Kernels, SchemeSumsAgreeWithinTheirReorderingBound) {
     double sum = 0.0;
     for (long i = 0; i < n; ++i) sum += std::abs(g[i] * (p1[i] - qm[i]));
     EXPECT_NEAR(s1, s2, n * 1.2e-16 * sum) << path->name;
+    // The linear step is the same update with no gradient: element by element, the bits of
+    // savUpdate's with c = 0 on every path, the loss term too.
+    for (const double* loss : {static_cast<const double*>(nullptr), x.data()}) {
+      base.savUpdate(n, g.data(), q.data(), qm.data(), minv.data(), kq.data(), loss, 0.7, 0.99,
+                     1e-9, 0.0, 1.0 / 1.01, p1.data());
+      path->linearUpdate(n, q.data(), qm.data(), minv.data(), kq.data(), loss, 0.7, 0.99, 1e-9,
+                         1.0 / 1.01, p2.data());
+      EXPECT_EQ(p1, p2) << path->name;
+    }
   }
 }
 

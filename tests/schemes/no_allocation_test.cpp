@@ -164,6 +164,32 @@ TEST(NoAllocation, StringVoiceProcess) {
   }
 }
 
+// The linear tail: the switch to the linear string and back at a strike, the linear steps with
+// the damper down and up (a threshold of 1e-3 takes C4 at velocity 0.1 linear within 20 ms).
+TEST(NoAllocation, StringVoiceLinearTail) {
+  StringPatch patch;
+  patch.string = pianoString(60);
+  patch.linearBelow = 1e-3;
+  StringVoice voice;
+  voice.prepare(patch, 60, 48000.0);
+  std::vector<float> left(256), right(256);
+  const long before = forbiddenNews;
+  forbidAllocation(true);
+  voice.noteOn(0.1);
+  bool linear = false;
+  for (int block = 0; block < 100; ++block) {
+    if (block == 50) voice.release();
+    voice.process(left, right);
+    linear = linear || voice.linear();
+  }
+  voice.noteOn(0.1);
+  voice.process(left, right);
+  forbidAllocation(false);
+  EXPECT_EQ(forbiddenNews - before, 0);
+  EXPECT_TRUE(linear);
+  EXPECT_FALSE(voice.linear());
+}
+
 // The plate: stencils, the bracket ℓ and the DST Airy solve (Eigen's blocked products), with
 // both losses, from a small grid to the largest the plate voice accepts.
 TEST(NoAllocation, SplitSavOnThePlate) {
