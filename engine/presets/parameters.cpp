@@ -622,7 +622,8 @@ constexpr Parameter kTable[] = {
      .defaultText = "1e-4",
      .model = kString,
      .doc = "The linear tail: once the hammer is back and the tension modulation's bound from "
-            "the string's energy H (ΔT/T0 <= EA H / (T0² L)) is under this, the string is "
+            "the string's energy H (ΔT/βT0 <= EA H / (β²T0² L), β the bend's tension scale) is "
+            "under this, the string is "
             "stepped linear — V' dropped for its quadratic part, the longitudinal "
             "wave kept at its speed — at 0.4–0.5 of the cost; a strike makes it geometric "
             "again. The pitch is then off by at most 866 × this cents (1e-4: 0.087 cents; measured "

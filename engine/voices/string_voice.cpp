@@ -369,7 +369,7 @@ void StringVoice::reset() noexcept {
   injected_ = caught_ = 0.0;
   separatedSteps_ = 0;
   quiet_.reset();
-  active_ = struck_ = linear_ = false;  // the copy's string is geometric
+  active_ = struck_ = linear_ = steppedLinear_ = false;  // the copy's string is geometric
   parked_ = true;
   applyBend();  // the copy brought back β = 1
 }
@@ -503,9 +503,10 @@ double StringVoice::pickup(const Vector& q, const Vector& qNext, double position
   return (at(qNext) - at(q)) / k_;
 }
 
-// The linear tail. The tension modulation, ΔT/T0 = (EA/2T0) Z̄ with Z̄ = (1/L) ∫ u_x² the mean
-// square slope, is bounded at every instant by the energy: H >= ½ βT0 L Z̄ (the rest of H —
-// kinetic, bending, v, the hammer parked at rest — is >= 0), so ΔT/T0 <= EA H / (βT0² L). Once
+// The linear tail. The tension modulation, ΔT = (EA/2) Z̄ with Z̄ = (1/L) ∫ u_x² the mean square
+// slope, raises the pitch by ΔT/βT0 of the bent tension, and is bounded at every instant by the
+// energy: H >= ½ βT0 L Z̄ (the rest of H — kinetic, bending, v, the hammer parked at rest — is
+// >= 0), so ΔT/βT0 <= EA H / (β² T0² L). Once
 // the hammer is parked and that bound has fallen under linearBelow, V' is dropped for its
 // quadratic part at rest (NonlinearString::setLinearised), and a step is Störmer–Verlet on the
 // linear string, one pass; over twice linearBelow again (energy the bridge brings from a sibling
@@ -515,8 +516,9 @@ double StringVoice::pickup(const Vector& q, const Vector& qNext, double position
 void StringVoice::checkLinear() noexcept {
   const NonlinearString& string = scheme_->system().string();
   const StringPhysics& p = string.physics();
+  const double beta = string.tensionScale();
   const double modulation =
-      p.young * p.area * energy() / (string.tensionScale() * p.tension * p.tension * p.length);
+      p.young * p.area * energy() / (beta * beta * p.tension * p.tension * p.length);
   if (!linear_ && parked_ && modulation < patch_.linearBelow)
     setLinear(true);
   else if (linear_ && modulation > 2.0 * patch_.linearBelow)
@@ -536,6 +538,7 @@ void StringVoice::setLinear(bool on) noexcept {
 }
 
 bool StringVoice::stepAndPick(double out[2]) noexcept {
+  steppedLinear_ = linear_;
   scheme_->step();
   catchHammer();
   if (linearisable_ && scheme_->stepIndex() % kLinearCheckSteps == 0) checkLinear();

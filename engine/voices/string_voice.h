@@ -133,9 +133,10 @@ class StringVoice {
   bool stepOnBridge(double w, double out[2]) noexcept;
   double pullOnBridge(double w) const noexcept { return coupling_.forceOnBridge(scheme_->q(), w); }
   // The string's tension change at its bridge end at q^n, N (NonlinearString::endTension()).
+  // That of the linear string where the last step was linear (the switch back comes after it).
   double endTension() const noexcept {
     const NonlinearString& s = scheme_->system().string();
-    return linear_ ? s.linearEndTension(scheme_->q()) : s.endTension();
+    return steppedLinear_ ? s.linearEndTension(scheme_->q()) : s.endTension();
   }
   const BridgeCoupling& coupling() const { return coupling_; }
   const StringPatch& patch() const { return patch_; }
@@ -186,7 +187,7 @@ class StringVoice {
   int separatedSteps_ = 0;
   bool active_ = false, struck_ = false;
   bool parked_ = true;  // the back-check holds the hammer (until the next strike)
-  bool linearisable_ = false, linear_ = false;
+  bool linearisable_ = false, linear_ = false, steppedLinear_ = false;
 };
 
 }  // namespace hamiltone
