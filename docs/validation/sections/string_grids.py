@@ -332,7 +332,14 @@ def run(ctx):
         "renders (and of 1 s of renders per key and velocity, the two voices' together), the "
         "transverse and two-grid voices taking turns; the reference rendered once. The least, "
         "not the median: the machine is shared, its other jobs only ever add to a render's time, "
-        "and the median ratios moved by ±0.1 between two runs of this report.\n")
+        "and the median ratios moved by ±0.1 between two runs of this report.\n\n"
+        "The two grids are the preset's, linear tail included (`scheme.linear_below`, "
+        "docs/string-grids.md): once a string's tension modulation is bounded under 1e-4 it is "
+        "stepped linear, which the transverse grid cannot be and the reference is not. Within "
+        "these 0.6 s that happens only on soft and short treble strings — F#6 and C7 at 30 and "
+        "50 from the hammer's catch, so their glide reads 0; C7 at 80 to 127 before the late "
+        "frames, whose pitch then reads up to 0.03 cents lower and the glide that much larger — "
+        "and it lowers their cost beside the transverse grid's.\n")
     out.append(code(command))
     if ctx.quick:
         out.append(f"(`--quick`: keys {', '.join(name[m] for m in keys)} only; the full report "
