@@ -105,7 +105,6 @@ class NonlinearString {
   // takes K again (stiffnessChanged) steps the linear string; the longitudinal wave keeps its
   // speed.
   void setLinearised(bool on) noexcept { linearised_ = on; }
-  bool linearised() const { return linearised_; }
   // The bound (44) for the linear string: v's block at EA. Where v's grid does not resolve the
   // longitudinal wave (c_L k > h_v, the transverse grid) it is shorter than a step there.
   double linearisedMaxStableStep(double sigma1) const;

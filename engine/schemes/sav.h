@@ -161,9 +161,9 @@ class SavScheme {
   // Drops part j's V'_j from the steps — a string gone linear, whose caller has put V''s quadratic
   // part at rest into K (NonlinearString::setLinearised) and takes K q again (stiffnessChanged()):
   // ∇V'_j is no longer taken and ψ_j is set to sqrt(2ε), so that its ½ψ_j² − ε is 0. The energy
-  // changes by what ψ_j held, which energy() then reports. With no part loaded and no damper, a
-  // step is then one pass: Störmer–Verlet with the loss (49). restorePart() takes V'_j back, ψ_j
-  // from V'_j(q^{n+½}) as resetPsi().
+  // changes by what ψ_j held, which energy() then reports. With no part loaded a step is then one
+  // pass: Störmer–Verlet with the loss (49) and the dampers (D1). restorePart() takes V'_j back,
+  // ψ_j from V'_j(q^{n+½}) as resetPsi().
   void dropPart(int part) noexcept requires(form == SavForm::split) {
     dropped_[part] = true;
     grads_[part].setZero();
@@ -173,7 +173,6 @@ class SavScheme {
     dropped_[part] = false;
     resetPsi(part);
   }
-  bool dropped(int part) const { return dropped_[part]; }
 
   // The instruction set of the one-part passes (default: selectedKernels()).
   void setKernels(const Kernels& kernels) noexcept { kernels_ = &kernels; }

@@ -148,8 +148,8 @@ class StringVoice {
   bool active() const { return active_; }
   bool linear() const { return linear_; }  // in its linear tail (linearBelow)
   double energy() const;                   // the scheme's H^{n+½} (ε excluded), J
-  // By the strikes, the bend's retensioning and the linear tail's switches (V' against its
-  // quadratic part at rest, either sign).
+  // By the strikes, the bend's retensioning and the linear tail's switches (what ψ held against
+  // V''s quadratic part at rest, either sign).
   double injectedEnergy() const { return injected_; }
   // Taken out by the back-check (the hammer's kinetic energy and its ψ residual). The string's
   // losses are not tallied on the audio path; with them off, energy() + removedEnergy() stays
