@@ -90,6 +90,8 @@ HammeredString::HammeredString(NonlinearString string, const HammerFelt& felt)
   // which is 0 at the end. Elsewhere the hats sum to 1 and so does J, to roundoff: made exact.
   if (x0 - a >= h && x0 + a <= length - h)
     for (double& w : contactWeight_) w /= total;
+  support_ = contactIndex_;
+  support_.push_back(hammerIndex());
 }
 
 double HammeredString::contactDisplacement(const Vector& q) const {

@@ -5,6 +5,7 @@
 // mezzo-forte hammer sinks 6 mm into the felt and stays there; with two it rebounds as it should.
 #pragma once
 
+#include <span>
 #include <vector>
 
 #include "instruments/string.h"
@@ -61,6 +62,11 @@ class HammeredString {
   double splitGradient(const Vector& q, Vector& grad) const;
   double partPotential(int part, const Vector& q) const;
   double partGradient(int part, const Vector& q, Vector& grad) const;
+  // Where ∇V'_j may be nonzero: the string's part everywhere (empty), the felt's at the hammer
+  // and the nodes under it (SavScheme sums and corrects it there alone).
+  std::span<const Eigen::Index> partSupport(int part) const {
+    return part == 0 ? std::span<const Eigen::Index>() : std::span<const Eigen::Index>(support_);
+  }
   void applyLossOperator(const Vector& a, const Vector& b, Vector& out) const;
   double lossOperatorEigenvalueMax() const { return string_.lossOperatorEigenvalueMax(); }
   double maxStableStep(double sigma1) const { return string_.maxStableStep(sigma1); }
@@ -74,6 +80,7 @@ class HammeredString {
   Vector inverseMass_;
   std::vector<Eigen::Index> contactIndex_;  // grid indices of u under the felt
   std::vector<double> contactWeight_;       // J there
+  std::vector<Eigen::Index> support_;       // the contact indices and the hammer's
 };
 
 }  // namespace hamiltone

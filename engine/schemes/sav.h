@@ -32,6 +32,9 @@ class SavScheme {
     if constexpr (partitioned) return S::potentialParts;
     return 1;
   }();
+  // A system that names each part's support (partSupport: the coordinates where ∇V'_j may be
+  // nonzero, empty for all of them) with part 0 dense and the others sparse: see sparseDots.
+  static constexpr bool sparseCapable = partitioned && requires(const S& s) { s.partSupport(0); };
   using Small = Eigen::Matrix<double, parts, parts>;
   using SmallVector = Eigen::Matrix<double, parts, 1>;
 
@@ -57,6 +60,10 @@ class SavScheme {
             (0.25 * params_.k) * system_.inverseMass().cwiseProduct(start.p);
     for (int j = 0; j < parts; ++j)
       psi_[j] = std::sqrt(2.0 * (quadratisedPotential(j, next_) + params_.epsilon));
+    if constexpr (sparseCapable) {
+      sparse_ = system_.partSupport(0).empty();
+      for (int j = 1; j < parts; ++j) sparse_ = sparse_ && !system_.partSupport(j).empty();
+    }
   }
 
   // One step of (38) [(27) when nonSplit]: q^{n+1} from q^n, q^{n−1}, ψ^{n−½} by (40) and
@@ -225,6 +232,9 @@ class SavScheme {
       }
     }
     const bool onePass = parts == 1 || loaded <= 1;
+    // Several parts loaded (a hammer on the string): the sparse ones (a felt's few nodes) are
+    // summed and corrected over their own coordinates, the dense one by the one-part kernels.
+    const bool sparse = !onePass && sparse_;
     // The loss's σ1 term and the external force enter b alike, b −= M⁻¹ extra_ with
     // extra_ = 2σ1k C(q^n − q^{n−1}) − k² f. Unforced with one part loaded, the kernels scale
     // C(q^n − q^{n−1}) as they read it (the same products, one pass fewer).
@@ -235,7 +245,7 @@ class SavScheme {
       if (forced_) {
         extra_ = (2.0 * params_.sigma1 * k) * lossForce - kk * force_;
         cq = extra_.data();
-      } else if (onePass) {
+      } else if (onePass || sparse) {
         cq = lossForce.data();
         cqScale = 2.0 * params_.sigma1 * k;
       } else {
@@ -258,13 +268,14 @@ class SavScheme {
     // kernels of the CPU's instruction set (kernels/kernels.h); with several, array reductions.
     double gq[parts] = {}, gqm[parts] = {}, gMKq[parts] = {}, gMCq[parts] = {};  // gMCq: of extra_
     double gMg[parts * parts] = {};
-    if (onePass) {
-      const int a = onlyLoaded;
+    if (onePass || sparse) {
+      const int a = onePass ? onlyLoaded : 0;
       double dots[5];
       kernels_->savDots(n, g[a], q, qm, minv, splitK ? kq : nullptr, lossy ? cq : nullptr, cqScale,
                         dots);
       gq[a] = dots[0], gqm[a] = dots[1], gMKq[a] = dots[2], gMCq[a] = dots[3];
       gMg[a * parts + a] = dots[4];
+      if (sparse) sparseDots(g, cq, cqScale, gq, gqm, gMKq, gMCq, gMg);
     } else {
 #pragma omp simd reduction(+ : gq[:parts], gqm[:parts], gMKq[:parts], gMCq[:parts], \
                                gMg[:parts * parts])
@@ -340,10 +351,11 @@ class SavScheme {
       return qp[i] = (b + correction) * invUp;
     };
     double gdq[parts] = {};
-    if (onePass) {
-      const int a = onlyLoaded;
+    if (onePass || sparse) {
+      const int a = onePass ? onlyLoaded : 0;
       gdq[a] = kernels_->savUpdate(n, g[a], q, qm, minv, splitK ? kq : nullptr,
                                    lossy ? cq : nullptr, cqScale, down, kk, c[a], invUp, qp);
+      if (sparse) sparseUpdate(g, c, invUp, gdq);
     } else {
 #pragma omp simd reduction(+ : gdq[:parts])
       for (Eigen::Index i = 0; i < n; ++i) {
@@ -378,6 +390,47 @@ class SavScheme {
       supplied_ += 0.5 * pointForce_[p] * (qp[pointIndex_[p]] - qm[pointIndex_[p]]);
     for (int a = 0; a < parts; ++a) psi_[a] += 0.5 * s[a] * gdq[a];  // (38c)
     finishStep<lossy>();
+  }
+
+  // The sparse parts' share of pass 1, part 0 dense (its sums from the kernels): each part's dot
+  // products over its support, and ∇V'_0ᵀ M⁻¹ ∇V'_a there — outside it ∇V'_a is 0. x read as
+  // xScale·x, as the kernels read it.
+  void sparseDots(const std::array<const double*, parts>& g, const double* x, double xScale,
+                  double* gq, double* gqm, double* gMKq, double* gMCq, double* gMg) const noexcept {
+    if constexpr (sparseCapable) {
+      const double *minv = system_.inverseMass().data(), *q = curr_.data(), *qm = prev_.data();
+      for (int a = 1; a < parts; ++a)
+        for (const Eigen::Index i : system_.partSupport(a)) {
+          const double ga = g[a][i];
+          gq[a] += ga * q[i];
+          gqm[a] += ga * qm[i];
+          if constexpr (splitK) gMKq[a] += ga * (minv[i] * kq_[i]);
+          if (x) gMCq[a] += ga * (minv[i] * (xScale * x[i]));
+          for (int b = 0; b < parts; ++b)
+            if (b != a && (b == 0 || b > a))
+              gMg[std::min(a, b) * parts + std::max(a, b)] += ga * minv[i] * g[b][i];
+          gMg[a * parts + a] += ga * minv[i] * ga;
+        }
+    }
+  }
+
+  // Pass 2's sparse share: after the kernels wrote q^{n+1} with part 0's correction, each sparse
+  // part's c_a M⁻¹∇V'_a over its support, part 0's ∇V'_0ᵀ(q^{n+1} − q^{n−1}) brought up to date
+  // there, then each sparse part's own sum.
+  void sparseUpdate(const std::array<const double*, parts>& g, const double* c, double invUp,
+                    double* gdq) noexcept {
+    if constexpr (sparseCapable) {
+      const double *minv = system_.inverseMass().data(), *qm = prev_.data();
+      double* qp = next_.data();
+      for (int a = 1; a < parts; ++a)
+        for (const Eigen::Index i : system_.partSupport(a)) {
+          const double dx = c[a] * (minv[i] * g[a][i]) * invUp;
+          qp[i] += dx;
+          gdq[0] += g[0][i] * dx;
+        }
+      for (int a = 1; a < parts; ++a)
+        for (const Eigen::Index i : system_.partSupport(a)) gdq[a] += g[a][i] * (qp[i] - qm[i]);
+    }
   }
 
   // The step's constants and its three levels: q^{n−1}, q^n and q^{n+1} being written.
@@ -527,6 +580,7 @@ class SavScheme {
   Vector kq_;                          // and K q there
   std::array<double, parts> psi_{};    // ψ_j^{n+½}
   std::array<bool, parts> dropped_{};  // dropPart()
+  bool sparse_ = false;                // part 0 dense, the others with a support (sparseCapable)
   Vector force_;                       // external force f, N per coordinate
   Vector extra_;  // 2σ1k C(q^n − q^{n−1}) − k² f: what b loses through M⁻¹
   bool forced_ = false;
