@@ -146,18 +146,18 @@ double NonlinearString::lossOperatorEigenvalueMax() const {
 }
 
 double NonlinearString::maxStableStep(double sigma1) const {
-  const double u = hamiltone::maxStableStep(stiffnessEigenvalueMax(), transverseLossTop(), sigma1);
-  if (grid_.longitudinal < 2) return u;
-  return std::min(u, hamiltone::maxStableStep(longitudinalEigenvalue(grid_.longitudinal - 1),
-                                              longitudinalLossTop(), sigma1));
+  return blockStableStep(sigma1, physics_.tension);
 }
 
 double NonlinearString::linearisedMaxStableStep(double sigma1) const {
+  return blockStableStep(sigma1, physics_.young * physics_.area);
+}
+
+double NonlinearString::blockStableStep(double sigma1, double vTension) const {
   const double u = hamiltone::maxStableStep(stiffnessEigenvalueMax(), transverseLossTop(), sigma1);
   if (grid_.longitudinal < 2) return u;
-  const double ea = physics_.young * physics_.area / physics_.tension;  // EA/T0
-  return std::min(u, hamiltone::maxStableStep(ea * longitudinalEigenvalue(grid_.longitudinal - 1),
-                                              longitudinalLossTop(), sigma1));
+  const double vTop = vTension / physics_.tension * longitudinalEigenvalue(grid_.longitudinal - 1);
+  return std::min(u, hamiltone::maxStableStep(vTop, longitudinalLossTop(), sigma1));
 }
 
 double NonlinearString::linearEndTension(const Vector& q) const {

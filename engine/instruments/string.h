@@ -121,6 +121,8 @@ class NonlinearString {
   // λmax(M⁻¹C) on u and on v (v's only where Mv >= 2).
   double transverseLossTop() const;
   double longitudinalLossTop() const;
+  // The bound (44) block by block, v's block at tension vTension (T0, or the linear string's EA).
+  double blockStableStep(double sigma1, double vTension) const;
   double singleGridPotential(const Vector& q) const;
   double singleGridGradient(const Vector& q, Vector& grad) const;
   double twoGridPotential(const Vector& q) const;

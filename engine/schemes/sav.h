@@ -323,12 +323,9 @@ class SavScheme {
         const Eigen::Index i = damperIndex_[m];
         const double d = damperD_[m];
         if (d == 0.0) continue;
-        double b = 2.0 * q[i] - down * qm[i] + d * qm[i];
-        if constexpr (splitK) b -= kk * (minv[i] * kq[i]);
-        if constexpr (lossy) b -= cqScale * minv[i] * cq[i];
+        double b = dampedBase<lossy>(v, i, d, cq, cqScale);
         for (int a = 0; a < parts; ++a) b += h[a] * minv[i] * g[a][i] * bLinear[a];
-        for (int p = 0; p < kPointForces; ++p)
-          if (pointIndex_[p] == i) b += kk * minv[i] * pointForce_[p];
+        addPointForces(v, i, b);
         bDamped[m] = b;
         const double shrink = up / (up + d) - 1.0;  // (1+σ0k) D⁻¹ − I at i
         for (int a = 0; a < parts; ++a) {
@@ -383,8 +380,7 @@ class SavScheme {
       const double dx = x - qp[i];
       qp[i] = x;
       for (int a = 0; a < parts; ++a) gdq[a] += g[a][i] * dx;
-      if (params_.trackDissipation)  // r/(4k) Δ², r = 2d/(k M⁻¹_ii)  (D1)
-        dissipated_ += d / (2.0 * k * k * minv[i]) * (x - qm[i]) * (x - qm[i]);
+      tallyDamper(v, i, d, x);
     }
     for (int p = 0; p < kPointForces; ++p)
       supplied_ += 0.5 * pointForce_[p] * (qp[pointIndex_[p]] - qm[pointIndex_[p]]);
@@ -406,10 +402,8 @@ class SavScheme {
           gqm[a] += ga * qm[i];
           if constexpr (splitK) gMKq[a] += ga * (minv[i] * kq_[i]);
           if (x) gMCq[a] += ga * (minv[i] * (xScale * x[i]));
-          for (int b = 0; b < parts; ++b)
-            if (b != a && (b == 0 || b > a))
-              gMg[std::min(a, b) * parts + std::max(a, b)] += ga * minv[i] * g[b][i];
-          gMg[a * parts + a] += ga * minv[i] * ga;
+          gMg[a] += ga * minv[i] * g[0][i];  // (0, a): with the dense part
+          for (int b = a; b < parts; ++b) gMg[a * parts + b] += ga * minv[i] * g[b][i];
         }
     }
   }
@@ -501,6 +495,27 @@ class SavScheme {
     finishStep<lossy>();
   }
 
+  // (D1)'s b' at a damped coordinate i, but for the parts' terms and the point forces:
+  // 2q_i − (1−σ0k) q_i^{n−1} + d q_i^{n−1} − k² M⁻¹(K q)_i − M⁻¹ x_i, x read as xScale·x.
+  template <bool lossy>
+  double dampedBase(const StepView& v, Eigen::Index i, double d, const double* x,
+                    double xScale) const noexcept {
+    double b = 2.0 * v.q[i] - v.down * v.qm[i] + d * v.qm[i];
+    if constexpr (splitK) b -= v.kk * (v.minv[i] * kq_[i]);
+    if constexpr (lossy) b -= xScale * v.minv[i] * x[i];
+    return b;
+  }
+  // The point forces on coordinate i into b: k² M⁻¹ f, slot by slot.
+  void addPointForces(const StepView& v, Eigen::Index i, double& b) const noexcept {
+    for (int p = 0; p < kPointForces; ++p)
+      if (pointIndex_[p] == i) b += v.kk * v.minv[i] * pointForce_[p];
+  }
+  // The damper's loss over the step at i, q_i^{n+1} = x: r/(4k) Δ², r = 2d/(k M⁻¹_ii)  (D1).
+  void tallyDamper(const StepView& v, Eigen::Index i, double d, double x) noexcept {
+    if (params_.trackDissipation)
+      dissipated_ += d / (2.0 * v.k * v.k * v.minv[i]) * (x - v.qm[i]) * (x - v.qm[i]);
+  }
+
   // The step with no part loaded (V' dropped, or at rest, and the hammer off the string):
   // ∇V' = 0 leaves (40) b / (1+σ0k), one pass; ψ stays as it is. A damped coordinate takes
   // b' / (1+σ0k + d) (D1).
@@ -517,15 +532,11 @@ class SavScheme {
       const double d = damperD_[m];
       if (d == 0.0) continue;
       const Eigen::Index i = damperIndex_[m];
-      double b = 2.0 * v.q[i] - v.down * v.qm[i] + d * v.qm[i];
-      if constexpr (splitK) b -= v.kk * (v.minv[i] * kq[i]);
-      if constexpr (lossy) b -= cqScale * v.minv[i] * cq[i];
-      for (int p = 0; p < kPointForces; ++p)
-        if (pointIndex_[p] == i) b += v.kk * v.minv[i] * pointForce_[p];
+      double b = dampedBase<lossy>(v, i, d, cq, cqScale);
+      addPointForces(v, i, b);
       const double x = b / (v.up + d);
       v.qp[i] = x;
-      if (params_.trackDissipation)  // r/(4k) Δ², r = 2d/(k M⁻¹_ii)  (D1)
-        dissipated_ += d / (2.0 * v.k * v.k * v.minv[i]) * (x - v.qm[i]) * (x - v.qm[i]);
+      tallyDamper(v, i, d, x);
     }
     for (int p = 0; p < kPointForces; ++p)
       supplied_ += 0.5 * pointForce_[p] * (v.qp[pointIndex_[p]] - v.qm[pointIndex_[p]]);

@@ -1,15 +1,17 @@
-// A partial's frequency measured from a recording: the Hann-windowed DFT magnitude at any
-// frequency, and the peak of it near an expected frequency, found by golden-section search.
+// A partial's frequency measured from a recording: the Hann-windowed DFT at any frequency, the
+// peak of its magnitude near an expected frequency, found by golden-section search, and a note's
+// pitch glide from those peaks.
 #pragma once
 
 #include <cmath>
+#include <complex>
 #include <numbers>
 #include <span>
 
 namespace hamiltone::testing {
 
-// |Σ w[n] x[n] e^{−2πi f n / rate}|, w the Hann window over x.
-inline double windowedMagnitude(std::span<const double> x, double hz, double rate) {
+// Σ w[n] x[n] e^{−2πi f n / rate}, w the Hann window over x, n from x's first sample.
+inline std::complex<double> windowedDft(std::span<const double> x, double hz, double rate) {
   double re = 0.0, im = 0.0;
   const double n = static_cast<double>(x.size());
   for (size_t i = 0; i < x.size(); ++i) {
@@ -18,7 +20,11 @@ inline double windowedMagnitude(std::span<const double> x, double hz, double rat
     re += w * x[i] * std::cos(phase);
     im -= w * x[i] * std::sin(phase);
   }
-  return std::hypot(re, im);
+  return {re, im};
+}
+
+inline double windowedMagnitude(std::span<const double> x, double hz, double rate) {
+  return std::abs(windowedDft(x, hz, rate));
 }
 
 // The spectral peak within ±`cents` of `expected`: for a partial isolated from its neighbours the
@@ -36,6 +42,14 @@ inline double peakFrequency(std::span<const double> x, double expected, double r
       a = c;
   }
   return 0.5 * (a + b);
+}
+
+// A struck note's pitch glide in cents: its fundamental (the peak within ±60 cents of f0) over the
+// first 0.1 s against 0.4–0.5 s, each Hann-windowed. x holds at least 0.5 s.
+inline double glideCents(std::span<const double> x, double f0, double rate) {
+  const auto tenth = static_cast<size_t>(0.1 * rate);
+  return 1200.0 * std::log2(peakFrequency(x.subspan(0, tenth), f0, rate, 60.0) /
+                            peakFrequency(x.subspan(4 * tenth, tenth), f0, rate, 60.0));
 }
 
 }  // namespace hamiltone::testing

@@ -15,7 +15,6 @@
 
 #include "instruments/piano_scale.h"
 #include "support/energy_checks.h"
-#include "support/modal.h"
 #include "support/spectrum.h"
 #include "voices/string_voice.h"
 
@@ -75,16 +74,6 @@ TEST(LinearTail, KeepsTheEnergyAccountExactlyAcrossTheSwitch) {
   EXPECT_LE(std::abs(voice.injectedEnergy() - struck), 1e-3 * struck);
 }
 
-// The phase of the component at `hz` in the Hann window of `n` samples from `from`.
-double phaseAt(const std::vector<double>& x, size_t from, size_t n, double hz) {
-  std::complex<double> sum = 0.0;
-  for (size_t i = 0; i < n; ++i) {
-    const double w = 0.5 - 0.5 * std::cos(2.0 * std::numbers::pi * i / (n - 1));
-    sum += w * x[from + i] * std::polar(1.0, -2.0 * std::numbers::pi * hz * (from + i) / kRate);
-  }
-  return std::arg(sum);
-}
-
 // C4 at velocity 0.5 with its losses: after the switch the linear string's fundamental drifts in
 // phase from the geometric string's at the rate of their pitch difference, which the modulation
 // left out bounds: ΔT/βT0 under the threshold τ is 1200 log2 √(1 + τ) <= 866 τ cents (0.087 at
@@ -123,8 +112,11 @@ TEST(LinearTail, StaysWithinItsThresholdsPitchOfTheGeometricString) {
     std::vector<double> t, drift;
     double unwrapped = 0.0, last = 0.0;
     for (size_t from = switched; from + window <= switched + 2 * 48000; from += window) {
-      const double d = std::remainder(phaseAt(a, from, window, f0) - phaseAt(b, from, window, f0),
-                                      2.0 * std::numbers::pi);
+      // Both windows' phases from the window's start: their difference is the drift.
+      auto phase = [&](const std::vector<double>& x) {
+        return std::arg(testing::windowedDft(std::span(x).subspan(from, window), f0, kRate));
+      };
+      const double d = std::remainder(phase(a) - phase(b), 2.0 * std::numbers::pi);
       unwrapped += std::remainder(d - last, 2.0 * std::numbers::pi);
       last = d;
       t.push_back(static_cast<double>(from) / kRate);
@@ -165,12 +157,7 @@ TEST(LinearTail, AStrikeMakesTheStringGeometricAgain) {
   play(linear, 0.5, a);
   play(geometric, 0.5, b);
   const double f0 = geometric.fundamentalHz();
-  auto glide = [&](const std::vector<double>& x) {
-    const std::span<const double> all(x);
-    return 1200.0 * std::log2(testing::peakFrequency(all.subspan(0, 4800), f0, kRate, 60.0) /
-                              testing::peakFrequency(all.subspan(19200, 4800), f0, kRate, 60.0));
-  };
-  const double ga = glide(a), gb = glide(b);
+  const double ga = testing::glideCents(a, f0, kRate), gb = testing::glideCents(b, f0, kRate);
   std::printf("C3 struck again at 127 in its tail: glide %.3f cents, geometric %.3f\n", ga, gb);
   EXPECT_GT(gb, 1.0);
   EXPECT_NEAR(ga / gb, 1.0, 0.02);
