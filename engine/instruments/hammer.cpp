@@ -145,4 +145,11 @@ void HammeredString::applyLossOperator(const Vector& a, const Vector& b, Vector&
   out[hammerIndex()] = 0.0;
 }
 
+void HammeredString::applyStiffnessAndLoss(const Vector& q, const Vector& qPrev, bool prevKept,
+                                           Vector& kq, Vector& cq) const {
+  string_.applyStiffnessAndLoss(q, qPrev, prevKept, kq, cq);
+  kq[hammerIndex()] = 0.0;
+  cq[hammerIndex()] = 0.0;
+}
+
 }  // namespace hamiltone

@@ -68,6 +68,8 @@ class HammeredString {
     return part == 0 ? std::span<const Eigen::Index>() : std::span<const Eigen::Index>(support_);
   }
   void applyLossOperator(const Vector& a, const Vector& b, Vector& out) const;
+  void applyStiffnessAndLoss(const Vector& q, const Vector& qPrev, bool prevKept, Vector& kq,
+                             Vector& cq) const;  // NonlinearString's; the hammer has neither
   double lossOperatorEigenvalueMax() const { return string_.lossOperatorEigenvalueMax(); }
   double maxStableStep(double sigma1) const { return string_.maxStableStep(sigma1); }
 

@@ -57,6 +57,8 @@ NonlinearString::NonlinearString(const StringPhysics& p, StringGrid grid)
   work3_.setZero(grid.transverse + kMaxLanes);
   for (Vector* w : {&cell1_, &cell2_, &cell3_}) w->setZero(grid.longitudinal);
   scratch_.setZero(grid.transverse + kMaxLanes);
+  d2_.setZero(nu);
+  d2Prev_.setZero(nu);
 }
 
 void NonlinearString::applyStiffness(const Vector& q, Vector& out) const {
@@ -168,17 +170,46 @@ double NonlinearString::linearEndTension(const Vector& q) const {
 }
 
 void NonlinearString::applyLossOperator(const Vector& a, const Vector& b, Vector& out) const {
-  const Eigen::Index nu = segments_ - 1, nv = grid_.longitudinal - 1;
+  const Eigen::Index nu = segments_ - 1;
   // M (−Λ) = −ρA h w D2 on each grid with its own h and weight, and ρA h_v w_v0 I on v.
   const double rhoA = physics_.linearDensity();
   kernels_->secondDifferenceOfDifference(a.data(), b.data(), out.data(), nu,
                                          -rhoA * lossWeights_.transverse / h_);
+  longitudinalLoss(a, b, out);
+}
+
+// C(a − b) on v: ρA h_v (w_v1 (−D2)/h_v² + w_v0 I)(a − b) (none where Mv = 1).
+void NonlinearString::longitudinalLoss(const Vector& a, const Vector& b, Vector& out) const {
+  const Eigen::Index nu = segments_ - 1, nv = grid_.longitudinal - 1;
   if (nv == 0) return;
+  const double rhoA = physics_.linearDensity();
   kernels_->secondDifferenceOfDifference(a.data() + nu, b.data() + nu, out.data() + nu, nv,
                                          -rhoA * lossWeights_.longitudinal / hv_);
   if (lossWeights_.longitudinalConstant > 0.0)
     out.segment(nu, nv) +=
         (rhoA * hv_ * lossWeights_.longitudinalConstant) * (a.segment(nu, nv) - b.segment(nu, nv));
+}
+
+void NonlinearString::applyStiffnessAndLoss(const Vector& q, const Vector& qPrev, bool prevKept,
+                                            Vector& kq, Vector& cq) const {
+  const Eigen::Index nu = segments_ - 1, nv = grid_.longitudinal - 1;
+  if (physics_.inertia == 0.0) {  // the stiffness is a single second difference: nothing to share
+    applyStiffness(q, kq);
+    applyLossOperator(q, qPrev, cq);
+    return;
+  }
+  const double invH2 = 1.0 / (h_ * h_);
+  if (!prevKept) kernels_->secondDifference(qPrev.data(), d2Prev_.data(), nu, invH2);
+  const double rhoA = physics_.linearDensity();
+  kernels_->stiffLossStencil(q.data(), d2_.data(), d2Prev_.data(), kq.data(), cq.data(), nu, invH2,
+                             tensionScale_ * physics_.tension * h_,
+                             physics_.young * physics_.inertia * h_,
+                             -rhoA * lossWeights_.transverse * h_);
+  d2_.swap(d2Prev_);
+  if (nv == 0) return;
+  const double vTension = linearised_ ? physics_.young * physics_.area : physics_.tension;
+  kernels_->secondDifference(q.data() + nu, kq.data() + nu, nv, -vTension / hv_);
+  longitudinalLoss(q, qPrev, cq);
 }
 
 namespace {

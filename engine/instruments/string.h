@@ -81,6 +81,12 @@ class NonlinearString {
   void setLossWeights(const LossWeights& weights);
   const LossWeights& lossWeights() const { return lossWeights_; }
   void applyLossOperator(const Vector& a, const Vector& b, Vector& out) const;
+  // applyStiffness(q, kq) and applyLossOperator(q, qPrev, cq) together: on u, C(q − qPrev) is
+  // −ρA w_u h (D2 q − D2 qPrev)/h², and the stiffness stencil takes D2 q/h² anyway; D2 qPrev/h² is
+  // the one this call took for its q the last time, when `prevKept` says that q was this qPrev
+  // (the scheme's previous step), else it is taken here. Equal to the two calls within roundoff.
+  void applyStiffnessAndLoss(const Vector& q, const Vector& qPrev, bool prevKept, Vector& kq,
+                             Vector& cq) const;
   // λmax(M⁻¹C): the larger of w_u (4/h²) sin²((Mu−1)π/2Mu) and w_v0 + w_v1 (4/h_v²) sin²(…) on v.
   double lossOperatorEigenvalueMax() const;
   // The bound (44) with the loss σ1, block by block: K and C act on u and on v apart, so the scheme
@@ -128,6 +134,7 @@ class NonlinearString {
   double twoGridPotential(const Vector& q) const;
   double twoGridGradient(const Vector& q, Vector& grad) const;
   void cellStrains(const Vector& q, double* strain, double* inverseStretch, double* zeta) const;
+  void longitudinalLoss(const Vector& a, const Vector& b, Vector& out) const;  // C(a − b) on v
 
   StringPhysics physics_;
   StringGrid grid_;
@@ -143,6 +150,7 @@ class NonlinearString {
   // each, scratch_ also the single grid's padded v) and per coarse cell (Mv).
   mutable Vector work1_, work2_, work3_, cell1_, cell2_, cell3_;
   mutable Vector scratch_;
+  mutable Vector d2_, d2Prev_;  // D2 u/h² of applyStiffnessAndLoss's q and of the one before
   const Kernels* kernels_ = &selectedKernels();
 };
 

@@ -112,6 +112,26 @@ HAMILTONE_TARGET void stiffStencil(const double* a, double* d2, double* out, lon
   out[n - 1] = -t * d2[n - 1] + ei * (invH2 * (d2[n - 2] - 2.0 * d2[n - 1]));
 }
 
+HAMILTONE_TARGET void stiffLossStencil(const double* a, double* d2, const double* d2Prev,
+                                       double* out, double* loss, long n, double invH2, double t,
+                                       double ei, double cl) {
+  secondDifference(a, d2, n, invH2);
+  if (n == 1) {
+    out[0] = -t * d2[0] + ei * (-2.0 * invH2 * d2[0]);
+    loss[0] = cl * (d2[0] - d2Prev[0]);
+    return;
+  }
+  out[0] = -t * d2[0] + ei * (invH2 * (d2[1] - 2.0 * d2[0]));
+  loss[0] = cl * (d2[0] - d2Prev[0]);
+#pragma omp simd
+  for (long j = 1; j < n - 1; ++j) {
+    out[j] = -t * d2[j] + ei * (invH2 * (d2[j - 1] - 2.0 * d2[j] + d2[j + 1]));
+    loss[j] = cl * (d2[j] - d2Prev[j]);
+  }
+  out[n - 1] = -t * d2[n - 1] + ei * (invH2 * (d2[n - 2] - 2.0 * d2[n - 1]));
+  loss[n - 1] = cl * (d2[n - 1] - d2Prev[n - 1]);
+}
+
 HAMILTONE_TARGET void secondDifferenceOfDifference(const double* a, const double* b, double* out,
                                                    long n, double c) {
   if (n == 1) {
@@ -277,6 +297,7 @@ extern const Kernels kernels{.isa = HAMILTONE_KERNEL_ISA,
                              .singleGridForces = singleGridForces,
                              .secondDifference = secondDifference,
                              .stiffStencil = stiffStencil,
+                             .stiffLossStencil = stiffLossStencil,
                              .secondDifferenceOfDifference = secondDifferenceOfDifference,
                              .savDots = savDots,
                              .savUpdate = savUpdate,

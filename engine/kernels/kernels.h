@@ -42,6 +42,11 @@ struct Kernels {
   // operations of two secondDifference passes and the sum, one pass fewer.
   void (*stiffStencil)(const double* a, double* d2, double* out, long n, double invH2, double t,
                        double ei);
+  // stiffStencil with the frequency-dependent loss of the same grid in its second sweep:
+  // loss_j = cl (d2_j − d2Prev_j), d2Prev the d2 this kernel (or secondDifference with c = invH2)
+  // left for the last state — cl D2(a − b)/h², the stencil of the difference not taken again.
+  void (*stiffLossStencil)(const double* a, double* d2, const double* d2Prev, double* out,
+                           double* loss, long n, double invH2, double t, double ei, double cl);
   // The same of a − b, the difference taken as it is read.
   void (*secondDifferenceOfDifference)(const double* a, const double* b, double* out, long n,
                                        double c);

@@ -20,6 +20,13 @@ concept HasLossOperator = requires(const S& s, const Vector& a, Vector& out) {
   { s.lossOperatorEigenvalueMax() } -> std::convertible_to<double>;
 };
 
+// A model whose stiffness stencil can give C(q^n − q^{n−1}) on the way (NonlinearString): K q^n
+// and C(q^n − q^{n−1}) in one call, `prevKept` true when its last such call was on q^{n−1}.
+template <class S>
+concept HasStiffnessAndLoss = requires(const S& s, const Vector& a, Vector& out) {
+  s.applyStiffnessAndLoss(a, a, true, out, out);
+};
+
 // With C = M(−L) and the backward difference δ−q = (q^n − q^{n−1})/k for the σ1 term,
 // multiplying the scheme by (q^{n+1} − q^{n−1})/2 gives
 //   Ĥ^{n+½} − Ĥ^{n−½} = −σ0/(2k) ‖Δ‖²_M − σ1/(2k) Δᵀ C Δ <= 0,   Δ = q^{n+1} − q^{n−1},
@@ -51,6 +58,15 @@ class LinearLoss {
     if constexpr (HasLossOperator<S>) {
       if (sigma1_ > 0.0) s.applyLossOperator(q, qPrev, cq_);
     }
+    return cq_;
+  }
+
+  // The same with K q^n into kq, both from the model's one call (HasStiffnessAndLoss), which
+  // sigma1 > 0 requires.
+  const Vector& frequencyForceAndStiffness(const S& s, const Vector& q, const Vector& qPrev,
+                                           bool prevKept,
+                                           Vector& kq) noexcept requires HasStiffnessAndLoss<S> {
+    s.applyStiffnessAndLoss(q, qPrev, prevKept, kq, cq_);
     return cq_;
   }
 

@@ -148,6 +148,7 @@ class SavScheme {
   void setCoordinate(Eigen::Index i, double qn, double qNext) noexcept {
     prev_[i] = qn;
     curr_[i] = qNext;
+    prevKept_ = false;
   }
 
   // After a change of K between steps (a string retensioned by the pitch bend): K q^n is taken
@@ -217,6 +218,21 @@ class SavScheme {
     // g_j = s_j ∇V'_j, and α_j = h_j M⁻¹∇V'_j, β_j = h_j ∇V'_j   (31).
     // A slack part (V'_j = 0, so ∇V'_j = 0: a hammer off the string) adds nothing to the update;
     // with at most one part under load the scalar one-part passes below serve.
+    // K q^n into kq_: with the loss's C(q^n − q^{n−1}) from the same sweep where the model can
+    // (HasStiffnessAndLoss), the last step's second difference kept for q^{n−1}.
+    const Vector* fusedLoss = nullptr;
+    if constexpr (splitK) {
+      if constexpr (lossy && HasStiffnessAndLoss<S>) {
+        if (params_.sigma1 > 0.0) {
+          fusedLoss = &loss_.frequencyForceAndStiffness(system_, curr_, prev_, prevKept_, kq_);
+          prevKept_ = true;  // of q^n, the next step's q^{n−1}
+        }
+      }
+      if (!fusedLoss) {
+        system_.applyStiffness(curr_, kq_);
+        prevKept_ = false;
+      }
+    }
     std::array<const double*, parts> g;
     double s[parts], h[parts];
     int loaded = 0, onlyLoaded = 0;
@@ -241,7 +257,8 @@ class SavScheme {
     const double* cq = nullptr;
     double cqScale = 1.0;
     if constexpr (lossy) {
-      const Vector& lossForce = loss_.frequencyForce(system_, curr_, prev_);
+      const Vector& lossForce =
+          fusedLoss ? *fusedLoss : loss_.frequencyForce(system_, curr_, prev_);
       if (forced_) {
         extra_ = (2.0 * params_.sigma1 * k) * lossForce - kk * force_;
         cq = extra_.data();
@@ -571,13 +588,9 @@ class SavScheme {
     return fullPotential(system_, q, kq_);
   }
 
-  // Its gradient at q^n into grads_[part] (and K q^n into kq_ where K is taken linearly, with
-  // part 0); returns the potential.
+  // Its gradient at q^n into grads_[part] (and K q^n into kq_ for (27)); returns the potential.
   double gradient(int part) noexcept {
     if constexpr (form == SavForm::nonSplit) return fullGradient(system_, curr_, grads_[0], kq_);
-    if constexpr (splitK) {
-      if (part == 0) system_.applyStiffness(curr_, kq_);
-    }
     if (dropped_[part]) return 0.0;
     if constexpr (partitioned) return system_.partGradient(part, curr_, grads_[part]);
     return system_.splitGradient(curr_, grads_[0]);
@@ -586,9 +599,10 @@ class SavScheme {
   S system_;
   StepParameters params_;
   LinearLoss<S> loss_;
-  Vector prev_, curr_, next_;          // q^n, q^{n+1}, workspace; rotated by swapping
-  std::array<Vector, parts> grads_;    // ∇V'_j (∇V for (27)) at the newest level a step used
-  Vector kq_;                          // and K q there
+  Vector prev_, curr_, next_;        // q^n, q^{n+1}, workspace; rotated by swapping
+  std::array<Vector, parts> grads_;  // ∇V'_j (∇V for (27)) at the newest level a step used
+  Vector kq_;                        // and K q there
+  bool prevKept_ = false;  // the model keeps what its stiffness sweep of q^{n−1} gave the loss
   std::array<double, parts> psi_{};    // ψ_j^{n+½}
   std::array<bool, parts> dropped_{};  // dropPart()
   bool sparse_ = false;                // part 0 dense, the others with a support (sparseCapable)

@@ -56,6 +56,20 @@ TEST(Kernels, StencilsAndForcesAreBitIdenticalOnEveryPath) {
       path->stiffStencil(a.data(), scratch2.data(), y.data(), n, 1e4, 3.0, 2e-5);
       EXPECT_EQ(x, stiff) << "portable n = " << n;
       EXPECT_EQ(x, y) << path->name << " n = " << n;
+      // With the loss from the same d2 and the last state's: the stiff stencil's bits, and
+      // loss_j = cl (d2_j − d2Prev_j) written out.
+      const std::vector<double> d2Prev = randomArray(n, 5.0, 3);
+      std::vector<double> loss(n), loss1(n), loss2(n);
+      for (long j = 0; j < n; ++j) loss[j] = -0.3 * (d2[j] - d2Prev[j]);
+      base.stiffLossStencil(a.data(), scratch1.data(), d2Prev.data(), x.data(), loss1.data(), n,
+                            1e4, 3.0, 2e-5, -0.3);
+      path->stiffLossStencil(a.data(), scratch2.data(), d2Prev.data(), y.data(), loss2.data(), n,
+                             1e4, 3.0, 2e-5, -0.3);
+      EXPECT_EQ(x, stiff) << "portable n = " << n;
+      EXPECT_EQ(scratch1, d2) << "portable n = " << n;
+      EXPECT_EQ(loss1, loss) << "portable n = " << n;
+      EXPECT_EQ(x, y) << path->name << " n = " << n;
+      EXPECT_EQ(loss1, loss2) << path->name << " n = " << n;
       base.secondDifferenceOfDifference(a.data(), b.data(), x.data(), n, 2.1);
       path->secondDifferenceOfDifference(a.data(), b.data(), y.data(), n, 2.1);
       EXPECT_EQ(x, y) << path->name << " n = " << n;
