@@ -85,6 +85,8 @@ class NonlinearString {
   // −ρA w_u h (D2 q − D2 qPrev)/h², and the stiffness stencil takes D2 q/h² anyway; D2 qPrev/h² is
   // the one this call took for its q the last time, when `prevKept` says that q was this qPrev
   // (the scheme's previous step), else it is taken here. Equal to the two calls within roundoff.
+  // For the scheme that steps this string alone: a call from elsewhere between its steps would
+  // replace what it kept.
   void applyStiffnessAndLoss(const Vector& q, const Vector& qPrev, bool prevKept, Vector& kq,
                              Vector& cq) const;
   // λmax(M⁻¹C): the larger of w_u (4/h²) sin²((Mu−1)π/2Mu) and w_v0 + w_v1 (4/h_v²) sin²(…) on v.
