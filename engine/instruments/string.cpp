@@ -62,11 +62,9 @@ NonlinearString::NonlinearString(const StringPhysics& p, StringGrid grid)
 }
 
 void NonlinearString::applyStiffness(const Vector& q, Vector& out) const {
-  const Eigen::Index n = segments_ - 1, nv = grid_.longitudinal - 1;
+  const Eigen::Index n = segments_ - 1;
   const double invH2 = 1.0 / (h_ * h_);
-  // −T0 h_v D2 v; the linear string's −EA h_v D2 v
-  const double vTension = linearised_ ? physics_.young * physics_.area : physics_.tension;
-  if (nv > 0) kernels_->secondDifference(q.data() + n, out.data() + n, nv, -vTension / hv_);
+  longitudinalStiffness(q, out);
   const double t = tensionScale_ * physics_.tension * h_;
   if (physics_.inertia == 0.0) {
     kernels_->secondDifference(q.data(), out.data(), n, -t * invH2);  // −βT0 h D2 u
@@ -192,7 +190,7 @@ void NonlinearString::longitudinalLoss(const Vector& a, const Vector& b, Vector&
 
 void NonlinearString::applyStiffnessAndLoss(const Vector& q, const Vector& qPrev, bool prevKept,
                                             Vector& kq, Vector& cq) const {
-  const Eigen::Index nu = segments_ - 1, nv = grid_.longitudinal - 1;
+  const Eigen::Index nu = segments_ - 1;
   if (physics_.inertia == 0.0) {  // the stiffness is a single second difference: nothing to share
     applyStiffness(q, kq);
     applyLossOperator(q, qPrev, cq);
@@ -206,10 +204,16 @@ void NonlinearString::applyStiffnessAndLoss(const Vector& q, const Vector& qPrev
                              physics_.young * physics_.inertia * h_,
                              -rhoA * lossWeights_.transverse * h_);
   d2_.swap(d2Prev_);
+  longitudinalStiffness(q, kq);
+  longitudinalLoss(q, qPrev, cq);
+}
+
+// K q on v: −T0 h_v D2 v; the linear string's −EA h_v D2 v (none where Mv = 1).
+void NonlinearString::longitudinalStiffness(const Vector& q, Vector& out) const {
+  const Eigen::Index nu = segments_ - 1, nv = grid_.longitudinal - 1;
   if (nv == 0) return;
   const double vTension = linearised_ ? physics_.young * physics_.area : physics_.tension;
-  kernels_->secondDifference(q.data() + nu, kq.data() + nu, nv, -vTension / hv_);
-  longitudinalLoss(q, qPrev, cq);
+  kernels_->secondDifference(q.data() + nu, out.data() + nu, nv, -vTension / hv_);
 }
 
 namespace {

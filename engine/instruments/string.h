@@ -136,6 +136,7 @@ class NonlinearString {
   double twoGridPotential(const Vector& q) const;
   double twoGridGradient(const Vector& q, Vector& grad) const;
   void cellStrains(const Vector& q, double* strain, double* inverseStretch, double* zeta) const;
+  void longitudinalStiffness(const Vector& q, Vector& out) const;              // K q on v
   void longitudinalLoss(const Vector& a, const Vector& b, Vector& out) const;  // C(a − b) on v
 
   StringPhysics physics_;

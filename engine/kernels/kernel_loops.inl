@@ -98,38 +98,40 @@ HAMILTONE_TARGET void secondDifference(const double* a, double* out, long n, dou
   out[n - 1] = c * (a[n - 2] - 2.0 * a[n - 1]);
 }
 
-HAMILTONE_TARGET void stiffStencil(const double* a, double* d2, double* out, long n, double invH2,
-                                   double t, double ei) {
+// stiffStencil's two sweeps, the second writing the loss too when `withLoss`.
+template <bool withLoss>
+HAMILTONE_TARGET void stiffSweeps(const double* a, double* d2, const double* d2Prev, double* out,
+                                  double* loss, long n, double invH2, double t, double ei,
+                                  double cl) {
   secondDifference(a, d2, n, invH2);
+  auto lossAt = [&](long j) {
+    if constexpr (withLoss) loss[j] = cl * (d2[j] - d2Prev[j]);
+  };
   if (n == 1) {
     out[0] = -t * d2[0] + ei * (-2.0 * invH2 * d2[0]);
+    lossAt(0);
     return;
   }
   out[0] = -t * d2[0] + ei * (invH2 * (d2[1] - 2.0 * d2[0]));
+  lossAt(0);
 #pragma omp simd
-  for (long j = 1; j < n - 1; ++j)
+  for (long j = 1; j < n - 1; ++j) {
     out[j] = -t * d2[j] + ei * (invH2 * (d2[j - 1] - 2.0 * d2[j] + d2[j + 1]));
+    lossAt(j);
+  }
   out[n - 1] = -t * d2[n - 1] + ei * (invH2 * (d2[n - 2] - 2.0 * d2[n - 1]));
+  lossAt(n - 1);
+}
+
+HAMILTONE_TARGET void stiffStencil(const double* a, double* d2, double* out, long n, double invH2,
+                                   double t, double ei) {
+  stiffSweeps<false>(a, d2, nullptr, out, nullptr, n, invH2, t, ei, 0.0);
 }
 
 HAMILTONE_TARGET void stiffLossStencil(const double* a, double* d2, const double* d2Prev,
                                        double* out, double* loss, long n, double invH2, double t,
                                        double ei, double cl) {
-  secondDifference(a, d2, n, invH2);
-  if (n == 1) {
-    out[0] = -t * d2[0] + ei * (-2.0 * invH2 * d2[0]);
-    loss[0] = cl * (d2[0] - d2Prev[0]);
-    return;
-  }
-  out[0] = -t * d2[0] + ei * (invH2 * (d2[1] - 2.0 * d2[0]));
-  loss[0] = cl * (d2[0] - d2Prev[0]);
-#pragma omp simd
-  for (long j = 1; j < n - 1; ++j) {
-    out[j] = -t * d2[j] + ei * (invH2 * (d2[j - 1] - 2.0 * d2[j] + d2[j + 1]));
-    loss[j] = cl * (d2[j] - d2Prev[j]);
-  }
-  out[n - 1] = -t * d2[n - 1] + ei * (invH2 * (d2[n - 2] - 2.0 * d2[n - 1]));
-  loss[n - 1] = cl * (d2[n - 1] - d2Prev[n - 1]);
+  stiffSweeps<true>(a, d2, d2Prev, out, loss, n, invH2, t, ei, cl);
 }
 
 HAMILTONE_TARGET void secondDifferenceOfDifference(const double* a, const double* b, double* out,

@@ -214,10 +214,6 @@ class SavScheme {
     double* qp = v.qp;
     const double* kq = kq_.data();
 
-    // (39): g_j = ∇V'_j / sqrt(2 (V'_j + ε)), g_j = 0 where V'_j + ε = 0; grads_ hold ∇V'_j, so
-    // g_j = s_j ∇V'_j, and α_j = h_j M⁻¹∇V'_j, β_j = h_j ∇V'_j   (31).
-    // A slack part (V'_j = 0, so ∇V'_j = 0: a hammer off the string) adds nothing to the update;
-    // with at most one part under load the scalar one-part passes below serve.
     // K q^n into kq_: with the loss's C(q^n − q^{n−1}) from the same sweep where the model can
     // (HasStiffnessAndLoss), the last step's second difference kept for q^{n−1}.
     const Vector* fusedLoss = nullptr;
@@ -233,6 +229,11 @@ class SavScheme {
         prevKept_ = false;
       }
     }
+
+    // (39): g_j = ∇V'_j / sqrt(2 (V'_j + ε)), g_j = 0 where V'_j + ε = 0; grads_ hold ∇V'_j, so
+    // g_j = s_j ∇V'_j, and α_j = h_j M⁻¹∇V'_j, β_j = h_j ∇V'_j   (31).
+    // A slack part (V'_j = 0, so ∇V'_j = 0: a hammer off the string) adds nothing to the update;
+    // with at most one part under load the scalar one-part passes below serve.
     std::array<const double*, parts> g;
     double s[parts], h[parts];
     int loaded = 0, onlyLoaded = 0;
