@@ -26,6 +26,7 @@
 #include "player.h"
 #include "preset_arguments.h"
 #include "recorder.h"
+#include "stop_signals.h"
 #include "usage_error.h"
 #include "version.h"
 
@@ -138,11 +139,6 @@ std::string describe(std::uint32_t m) {
   return text;
 }
 
-std::string signalName(int signal) {
-  const char* abbreviation = ::sigabbrev_np(signal);
-  return abbreviation ? std::string("SIG") + abbreviation : "signal " + std::to_string(signal);
-}
-
 // The workers take the real-time policy and priority the audio API gave its callback thread (JACK
 // with --realtime, ALSA's SCHED_RR): that thread spins until the keys the workers took are done,
 // so a worker of lower priority, kept off its core by other programs, would make it late.
@@ -198,6 +194,9 @@ int play(const PlayArguments& a) {
   if (a.presets.empty()) inputs.push_back({"--preset (the default)", HAMILTONE_DEFAULT_PRESET});
   if (!a.midi.empty()) inputs.push_back({"--midi", a.midi});
   cli::refuseInputAsOutput("--record", a.record, inputs);
+  // The file's type by its extension, as hamiltone-render's -o: checked before anything is opened.
+  const cli::FileType recordType =
+      a.record.empty() ? cli::FileType::wav : cli::fileTypeOf(a.record, "--record");
 
   // Every signal that would end the program stops it instead, completing the recording: they are
   // taken by this thread alone (sigtimedwait below), and every thread started from here on —
@@ -205,12 +204,15 @@ int play(const PlayArguments& a) {
   // SIGHUP) is left out: blocked, Linux would queue it for sigtimedwait rather than drop it.
   sigset_t stopSignals;
   sigemptyset(&stopSignals);
-  for (const int s : cli::AtomicFile::kEndingSignals) {
+  for (const int s : cli::AtomicFile::endingSignals()) {
     struct sigaction current {};
     if (::sigaction(s, nullptr, &current) == 0 && current.sa_handler != SIG_IGN)
       sigaddset(&stopSignals, s);
   }
   pthread_sigmask(SIG_BLOCK, &stopSignals, nullptr);
+  std::unique_ptr<Recorder> recorder;  // outlives the stop signals' thread, which may finish it
+  StopSignals stops(stopSignals);
+  stops.setRecordPath(a.record);
 
   // Presets load and their voices are built here, off the audio thread; program change then only
   // switches between instruments that are ready.
@@ -232,8 +234,13 @@ int play(const PlayArguments& a) {
     throw cli::UsageError(std::string("preset does not build at this sample rate: ") + e.what());
   }
   synth.setPolyphony(voices);
-  std::unique_ptr<Recorder> recorder;
-  if (!a.record.empty()) recorder = std::make_unique<Recorder>(a.record, static_cast<int>(rate));
+  if (!a.record.empty()) {
+    if (recordType == cli::FileType::ogg && rate > cli::kOggMaxRate)
+      throw cli::UsageError("--record = " + a.record + ": Ogg Vorbis holds at most " +
+                            std::to_string(cli::kOggMaxRate) + " Hz, and the stream runs at " +
+                            std::to_string(rate) + " Hz; record to a .wav or .flac file");
+    recorder = std::make_unique<Recorder>(a.record, static_cast<int>(rate), recordType);
+  }
   Player player(synth, midi.queue(), recorder ? &recorder->ring() : nullptr, rate, 8192,
                 cpuLimit / 100.0);
   if (!score.what.empty()) player.setScore(score.messages, !a.keepListening);
@@ -250,7 +257,10 @@ int play(const PlayArguments& a) {
     midi.openPort(static_cast<int>(cli::parseInteger("--midi-port", a.midiPort, 0)));
   else if (score.what.empty() || a.keepListening)
     warnNoMidiInput(midi);
-  if (recorder) recorder->start();
+  if (recorder) {
+    recorder->start();
+    stops.setRecorder(recorder.get());
+  }
   audio.start();
 
   const bool status = !a.quiet && ::isatty(2);
@@ -277,7 +287,7 @@ int play(const PlayArguments& a) {
   bool recordingFailureShown = false, lost = false, scheduled = false, finished = false,
        portGone = false;
   while (signal < 0) {
-    signal = sigtimedwait(&stopSignals, nullptr, &wait);
+    signal = stops.wait(wait);
     if (signal >= 0) break;
     if (!scheduled && player.callbackThread()) {
       scheduled = true;
@@ -373,7 +383,11 @@ int play(const PlayArguments& a) {
                  s.limiterDeepestDb, s.limitedFrames);
   if (recorder) {
     const double seconds = recorder->finish();
-    if (!recorder->failed()) {
+    if (recorder->empty()) {
+      std::fprintf(stderr, "hamiltone-play: nothing was recorded (no audio was played); %s\n",
+                   std::filesystem::exists(a.record) ? (a.record + " is as it was").c_str()
+                                                     : (a.record + " was not written").c_str());
+    } else if (!recorder->failed()) {
       std::fprintf(stderr, "hamiltone-play: recorded %.2f s to %s%s%s\n", seconds, a.record.c_str(),
                    s.recordDropped ? " (with gaps: the disk fell behind)" : "",
                    recorder->truncatedFrames() ? " (cut at the 4 GiB a WAV file holds)" : "");
@@ -391,8 +405,7 @@ int play(const PlayArguments& a) {
   }
   if (lost) return kExitAudioLost;
   if (finished) return 0;
-  // The signals meant to stop a program end it normally; another is reported as a shell would.
-  return signal == SIGINT || signal == SIGTERM || signal == SIGHUP ? 0 : 128 + signal;
+  return stopExitCode(signal);
 }
 
 }  // namespace
@@ -418,7 +431,10 @@ int main(int argc, char** argv) {
   cli::addNumberOption(&app, "--midi-port", a.midiPort, "N",
                        "MIDI input port (see --list-devices)");
   app.add_option("--virtual-midi", a.virtualMidi, "create a MIDI input port with this name")
-      ->type_name("NAME");
+      ->type_name("NAME")
+      ->check([](const std::string& name) {
+        return name.empty() ? std::string("is empty: expected a port name") : std::string();
+      });
   app.add_option("--midi", a.midi,
                  "also play this Standard MIDI File (format 0 or 1) live, from the start of the "
                  "stream; the player exits when it has played and its last note died away")
@@ -431,8 +447,13 @@ int main(int argc, char** argv) {
       ->type_name("LIST");
   app.add_flag("--keep-listening", a.keepListening,
                "after --midi or --notes, play on from MIDI input until stopped");
-  app.add_option("--record", a.record, "also write what is played to this WAV file (24-bit)")
-      ->type_name("FILE");
+  app.add_option("--record", a.record,
+                 "also write what is played to this file, its type chosen by the extension: "
+                 ".wav or .flac (24-bit), .ogg (Ogg Vorbis)")
+      ->type_name("FILE")
+      ->check([](const std::string& path) {
+        return path.empty() ? std::string("is empty: expected a file path") : std::string();
+      });
   cli::addNumberOption(&app, "--voices", a.voices, "N",
                        "polyphony, 1 … 128 (default: the preset's)");
   cli::addNumberOption(&app, "--threads", a.threads, "N",
@@ -444,8 +465,9 @@ int main(int argc, char** argv) {
   app.add_flag("--list-devices", a.listDevices, "list the APIs, output devices and MIDI ports");
   app.add_flag("--quiet", a.quiet, "no status line");
   app.footer(
-      "Signals: SIGINT, SIGTERM and SIGHUP stop it normally; SIGUSR1, SIGPIPE, SIGALRM and the "
-      "other signals that would end it stop it too, completing the recording, and exit 128+N; "
+      "Signals: SIGINT, SIGTERM and SIGHUP stop it normally; SIGQUIT (Ctrl-\\), SIGUSR1, SIGPIPE, "
+      "SIGALRM and the other signals sent to end it stop it too, completing the recording, and "
+      "exit 128+N; "
       "a signal ignored when it starts (nohup) stays ignored. "
       "Exit codes: 0 stopped by SIGINT/SIGTERM/SIGHUP, or --midi/--notes played to the end (the "
       "recording is complete), 1 an I/O error "

@@ -5,13 +5,15 @@
 #include <algorithm>
 #include <chrono>
 #include <exception>
+#include <limits>
 #include <vector>
 
 namespace hamiltone::app {
 
-Recorder::Recorder(const std::string& path, int sampleRate)
-    : wav_(path, "--record", sampleRate, 2, cli::SampleFormat::pcm24),
+Recorder::Recorder(const std::string& path, int sampleRate, cli::FileType type)
+    : wav_(path, "--record", sampleRate, 2, cli::SampleFormat::pcm24, type),
       ring_(static_cast<size_t>(kRingSeconds * sampleRate * 2)),
+      maxFrames_(type == cli::FileType::wav ? kMaxFrames : std::numeric_limits<long>::max()),
       sampleRate_(sampleRate) {}
 
 Recorder::~Recorder() {
@@ -38,7 +40,7 @@ void Recorder::drain() {
     if (failed_.load(std::memory_order_relaxed)) continue;  // emptied, so the audio goes on
     // Frames (the audio thread pushes whole ones), up to what a WAV file can hold: 4 GiB of
     // 24-bit stereo, 4.1 h at 48 kHz; the rest is dropped and counted.
-    const long frames = std::min(static_cast<long>(n / 2), kMaxFrames - frames_);
+    const long frames = std::min(static_cast<long>(n / 2), maxFrames_ - frames_);
     try {
       if (frames > 0) wav_.write(chunk.data(), static_cast<size_t>(frames));
     } catch (const std::exception& e) {
@@ -54,10 +56,12 @@ void Recorder::drain() {
 }
 
 double Recorder::finish() noexcept {
+  const std::lock_guard<std::mutex> lock(finishing_);
   if (!finished_) {
     stopping_ = true;
     if (writer_.joinable()) writer_.join();
     finished_ = true;
+    if (frames_ == 0 && !failed()) return 0.0;  // the temporary goes with wav_
     try {
       wav_.commit();
       kept_ = true;

@@ -22,9 +22,20 @@
 
 namespace hamiltone::cli {
 
-// SIGXFSZ: past the file-size limit (ulimit -f). Not SIGQUIT, whose core dump is wanted as is.
-const int AtomicFile::kEndingSignals[12] = {SIGHUP,  SIGINT,    SIGTERM, SIGUSR1, SIGUSR2, SIGPIPE,
-                                            SIGALRM, SIGVTALRM, SIGPROF, SIGXCPU, SIGXFSZ, SIGPOLL};
+const std::vector<int>& AtomicFile::endingSignals() {
+  // SIGXFSZ: past the file-size limit (ulimit -f). SIGQUIT (Ctrl-\) too: its core dump is not
+  // worth a lost recording; gcore, or SIGABRT, still takes one.
+  static const std::vector<int> signals = [] {
+    std::vector<int> s = {SIGHUP,    SIGINT,  SIGQUIT, SIGTERM, SIGUSR1, SIGUSR2, SIGPIPE,  SIGALRM,
+                          SIGVTALRM, SIGPROF, SIGXCPU, SIGXFSZ, SIGPOLL, SIGPWR,  SIGSTKFLT};
+    for (int r = SIGRTMIN; r <= SIGRTMAX; ++r) {
+      struct sigaction current {};
+      if (::sigaction(r, nullptr, &current) == 0 && current.sa_handler == SIG_DFL) s.push_back(r);
+    }
+    return s;
+  }();
+  return signals;
+}
 
 namespace {
 
@@ -40,9 +51,21 @@ struct Slot {
 static_assert(std::atomic<int>::is_always_lock_free);
 Slot liveTemporaries[AtomicFile::kMaxLive];
 
-const auto& kHandledSignals = AtomicFile::kEndingSignals;
+// Whether files are being put in place (commit, commitTogether), for a signal that comes then.
+enum Publishing : int { kWriting = 0, kPublishing = 1, kFailed = 2 };
+std::atomic<int> publishing{kWriting};
+static_assert(std::atomic<int>::is_always_lock_free);
 
 extern "C" void removeTemporariesAndExit(int signal) {
+  // Taken by another thread while the files are being renamed into place (the renaming thread
+  // holds the signals back): wait for it. Once all of them are in place, the signal came too
+  // late to stop the run; if one failed, it ends the run as any other.
+  if (publishing.load() == kPublishing) {
+    int state;
+    while ((state = publishing.load()) == kPublishing) {
+    }
+    if (state != kFailed) return;
+  }
   for (Slot& slot : liveTemporaries)
     if (slot.state.load() == kLive) ::unlink(slot.path);
   ::_exit(128 + signal);
@@ -53,11 +76,12 @@ extern "C" void removeTemporariesAndExit(int signal) {
 void installHandler() {
   static std::once_flag once;
   std::call_once(once, [] {
+    const std::vector<int>& handled = AtomicFile::endingSignals();
     struct sigaction action {};
     action.sa_handler = removeTemporariesAndExit;
     sigemptyset(&action.sa_mask);
-    for (const int s : kHandledSignals) sigaddset(&action.sa_mask, s);  // one handler at a time
-    for (const int s : kHandledSignals) {
+    for (const int s : handled) sigaddset(&action.sa_mask, s);  // one handler at a time
+    for (const int s : handled) {
       struct sigaction current {};
       if (::sigaction(s, nullptr, &current) == 0 && current.sa_handler == SIG_IGN) continue;
       ::sigaction(s, &action, nullptr);
@@ -104,6 +128,7 @@ int addLive(const std::string& path) {
     if (!liveTemporaries[i].state.compare_exchange_strong(expected, kFilling)) continue;
     std::memcpy(liveTemporaries[i].path, path.c_str(), path.size() + 1);
     liveTemporaries[i].state.store(kLive);
+    publishing.store(kWriting);  // after a failed publish: a signal ends the run again
     installHandler();
     return i;
   }
@@ -116,22 +141,45 @@ void removeLive(int& slot) {
 }
 
 // Holds the handled signals back on this thread while alive; a held signal is delivered (and
-// ends the program) when it ends.
+// ends the program) when it ends, unless absorbed.
 class SignalsHeld {
  public:
   SignalsHeld() {
-    sigset_t held;
-    sigemptyset(&held);
-    for (const int s : kHandledSignals) sigaddset(&held, s);
-    ::pthread_sigmask(SIG_BLOCK, &held, &previous_);
+    sigemptyset(&held_);
+    for (const int s : AtomicFile::endingSignals()) sigaddset(&held_, s);
+    ::pthread_sigmask(SIG_BLOCK, &held_, &previous_);
   }
   ~SignalsHeld() { ::pthread_sigmask(SIG_SETMASK, &previous_, nullptr); }
   SignalsHeld(const SignalsHeld&) = delete;
   SignalsHeld& operator=(const SignalsHeld&) = delete;
 
+  // Takes the held signals that came meanwhile, so that they are not delivered at the end.
+  void absorb() {
+    const timespec now{0, 0};
+    while (::sigtimedwait(&held_, nullptr, &now) > 0) {
+    }
+  }
+
  private:
-  sigset_t previous_;
+  sigset_t held_, previous_;
 };
+
+// Renames the files into place with the signals held back on this thread and, for a signal
+// another thread takes, `publishing` set (removeTemporariesAndExit). A signal that came meanwhile
+// is then too late to stop the run: absorbed once every file is in place.
+template <class Publish>
+void publishHeld(Publish publishAll) {
+  SignalsHeld held;
+  publishing.store(kPublishing);
+  try {
+    publishAll();
+  } catch (...) {
+    publishing.store(kFailed);
+    throw;
+  }
+  held.absorb();
+  publishing.store(kWriting);
+}
 
 }  // namespace
 
@@ -259,27 +307,27 @@ void AtomicFile::publish() {
 
 void AtomicFile::commit() {
   finish();
-  SignalsHeld held;
-  publish();
+  publishHeld([this] { publish(); });
 }
 
 void commitTogether(std::initializer_list<AtomicFile*> files) {
   for (AtomicFile* file : files)
     if (file) file->finish();  // the first failure throws; the destructors remove them all
-  SignalsHeld held;
-  std::vector<AtomicFile*> created;  // published where no file was: removed again on a failure
-  for (AtomicFile* file : files) {
-    if (!file) continue;
-    struct stat existing {};
-    const bool isNew = ::lstat(file->path().c_str(), &existing) != 0;
-    try {
-      file->publish();
-    } catch (...) {
-      for (AtomicFile* done : created) ::unlink(done->path().c_str());
-      throw;
+  publishHeld([&files] {
+    std::vector<AtomicFile*> created;  // published where no file was: removed again on a failure
+    for (AtomicFile* file : files) {
+      if (!file) continue;
+      struct stat existing {};
+      const bool isNew = ::lstat(file->path().c_str(), &existing) != 0;
+      try {
+        file->publish();
+      } catch (...) {
+        for (AtomicFile* done : created) ::unlink(done->path().c_str());
+        throw;
+      }
+      if (isNew) created.push_back(file);
     }
-    if (isNew) created.push_back(file);
-  }
+  });
 }
 
 }  // namespace hamiltone::cli

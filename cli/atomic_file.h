@@ -29,9 +29,11 @@ class AtomicFile {
   // UsageError naming `flag` and the path (also for a symlink to nothing: neither followed, as
   // it would create a file elsewhere, nor replaced, as the link may be meant).
   //
-  // Every signal whose default would end the program (kEndingSignals) removes every live
-  // temporary (up to kMaxLive at once; one more is a std::runtime_error) and exits 128 + N —
-  // except a signal the program inherited as ignored (nohup's SIGHUP), which stays ignored.
+  // Every signal sent to end the program (endingSignals()) removes every live temporary (up to
+  // kMaxLive at once; one more is a std::runtime_error) and exits 128 + N — except a signal the
+  // program inherited as ignored (nohup's SIGHUP), which stays ignored. One that comes while
+  // commit() or commitTogether() puts the files in place waits for them; once they all are, it
+  // came too late to stop the run, and the run ends as it would have.
   // The temporary is named PATH.tmp-PID-XXXXXX: one left by a run that could not clean up
   // (SIGKILL, a crash) is removed when a later run writes PATH and that PID is gone.
   AtomicFile(std::string path, const std::string& flag);
@@ -40,7 +42,11 @@ class AtomicFile {
   AtomicFile& operator=(const AtomicFile&) = delete;
 
   static constexpr int kMaxLive = 16;
-  static const int kEndingSignals[12];
+  // Those whose default is to terminate or to quit, the real-time ones included, less the faults
+  // (SIGILL, SIGBUS, SIGFPE, SIGSEGV, SIGABRT, SIGTRAP, SIGSYS) that a crash raises in the thread
+  // that made it, where no cleanup is safe. A real-time signal is left out when the process already
+  // handles it (a library's own).
+  static const std::vector<int>& endingSignals();
 
   std::FILE* stream() { return file_; }
   // Flushes and closes the temporary, keeping it; throws std::runtime_error on an I/O error (a

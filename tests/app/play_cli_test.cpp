@@ -88,6 +88,24 @@ TEST_F(PlayCli, RefusesToRecordOntoAPreset) {
   }
 }
 
+// An empty --record or --virtual-midi was taken as no recording or no port, saying nothing; a
+// --record of another type than its extension names (a WAV written as take.flac) or of no type
+// the recorder writes is refused before any device, naming the extensions it takes.
+TEST_F(PlayCli, RefusesAnEmptyRecordOrPortAndARecordingOfNoKnownType) {
+  for (const std::string& args : {std::string("--record ''"), std::string("--virtual-midi ''")}) {
+    const CommandResult r = play("--quiet " + args);
+    EXPECT_EQ(r.exitCode, 2) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find("is empty"), std::string::npos) << args << "\n" << r.err;
+  }
+  const fs::path mp3 = dir_ / "take.mp3";
+  const CommandResult r = play("--quiet --record " + mp3.string());
+  EXPECT_EQ(r.exitCode, 2) << r.err;
+  EXPECT_NE(r.err.find("--record"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(".flac"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(mp3));
+  EXPECT_TRUE(fs::is_empty(dir_)) << "a temporary was left";
+}
+
 // --midi FILE: a file that is missing or is not a Standard MIDI File is refused before any device,
 // naming the file and what is wrong, as hamiltone-render says it.
 TEST_F(PlayCli, RefusesAMissingOrCorruptMidiFile) {

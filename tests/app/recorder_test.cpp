@@ -1,6 +1,7 @@
 // The recorder meeting a write error (a full disk): the recording stops, the sound does not (the
 // ring keeps being emptied), nothing throws or aborts, and finish() leaves either a valid WAV of
-// what was written before the error or no file at all — never a temporary.
+// what was written before the error or no file at all — never a temporary; and a recording of
+// nothing leaves the path as it was.
 #include "recorder.h"
 
 #include <fcntl.h>
@@ -11,8 +12,10 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 #include "support/scratch_dir.h"
@@ -138,6 +141,54 @@ TEST_F(RecorderTest, AFileThatCannotBeFinalisedIsRemoved) {
     EXPECT_NE(recorder.error().find("take.wav"), std::string::npos) << recorder.error();
   }
   EXPECT_TRUE(listing(dir_).empty());
+}
+
+// --record take.flac is a FLAC file (24-bit), take.ogg an Ogg Vorbis one: what the extension says,
+// as hamiltone-render's -o, where a WAV was written under any name.
+TEST_F(RecorderTest, WritesTheTypeItsExtensionNames) {
+  for (const auto& [name, type, format] :
+       {std::tuple{"take.flac", cli::FileType::flac, SF_FORMAT_FLAC | SF_FORMAT_PCM_24},
+        std::tuple{"take.ogg", cli::FileType::ogg, SF_FORMAT_OGG | SF_FORMAT_VORBIS}}) {
+    const fs::path take = dir_ / name;
+    {
+      Recorder recorder(take.string(), kRate, type);
+      recorder.start();
+      ASSERT_TRUE(push(recorder, 0, kRate / 4));
+      EXPECT_DOUBLE_EQ(recorder.finish(), 0.25) << name;
+      EXPECT_TRUE(recorder.kept()) << recorder.error();
+    }
+    SF_INFO info{};
+    SNDFILE* file = sf_open(take.c_str(), SFM_READ, &info);
+    ASSERT_NE(file, nullptr) << name << ": " << sf_strerror(nullptr);
+    EXPECT_EQ(info.format, format) << name;
+    EXPECT_EQ(info.frames, kRate / 4) << name;
+    EXPECT_EQ(info.channels, 2) << name;
+    sf_close(file);
+  }
+}
+
+// A recording of nothing (the stream never ran: the audio server went away as it started) does
+// not replace the file at its path, nor leave a temporary; finish() from two threads at once
+// (the stop signals' thread and the main one) finishes once and both see the same.
+TEST_F(RecorderTest, ANothingRecordedLeavesTheFileAsItWas) {
+  const fs::path take = dir_ / "take.wav";
+  { std::ofstream(take) << "an earlier take"; }
+  {
+    Recorder recorder(take.string(), kRate);
+    recorder.start();
+    double other = -1.0;
+    std::thread second([&] { other = recorder.finish(); });
+    const double seconds = recorder.finish();
+    second.join();
+    EXPECT_EQ(seconds, 0.0);
+    EXPECT_EQ(other, 0.0);
+    EXPECT_TRUE(recorder.empty());
+    EXPECT_FALSE(recorder.kept());
+    EXPECT_FALSE(recorder.failed());
+  }
+  EXPECT_EQ(listing(dir_), std::vector<std::string>{"take.wav"});
+  std::ifstream in(take);
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), "an earlier take");
 }
 
 }  // namespace

@@ -76,14 +76,51 @@ TEST_F(AtomicFileTest, SignalRemovesEveryLiveTemporary) {
   EXPECT_TRUE(listing().empty());
 }
 
-// Every signal that would end the program by default removes the temporaries, not only the
-// usual three: a stray SIGUSR1, a SIGPIPE from a closed pipe, a timeout's SIGALRM.
+// Every signal sent to end the program removes the temporaries, not only the usual three: a stray
+// SIGUSR1, a SIGPIPE from a closed pipe, a timeout's SIGALRM, Ctrl-\'s SIGQUIT, SIGPWR, the
+// real-time signals.
 TEST_F(AtomicFileTest, EverySignalThatWouldEndTheProgramRemovesTheTemporaries) {
-  for (const int signal : AtomicFile::kEndingSignals) {
+  for (const int signal : AtomicFile::endingSignals()) {
     EXPECT_EXIT(threeOpenThenSignal(dir_, signal), ::testing::ExitedWithCode(128 + signal), "")
         << ::strsignal(signal);
     EXPECT_TRUE(listing().empty()) << ::strsignal(signal);
   }
+}
+
+// A signal that comes while the files are renamed into place (here: already pending when the
+// renaming begins, held back on this thread) is too late to stop the run: taken, it leaves the
+// run to end as it would have, with every file in place. When a rename fails, the same signal
+// ends the run as any other: exit 128 + N, no temporary left.
+void signalWhileRenaming(const fs::path& dir, bool renameFails) {
+  AtomicFile a((dir / "a.csv").string(), "--out");
+  AtomicFile b((dir / "b.csv").string(), "--snapshot-out");
+  std::fputs("a\n", a.stream());
+  std::fputs("b\n", b.stream());
+  if (renameFails) fs::create_directory(dir / "b.csv");  // rename(2) onto a directory fails
+  sigset_t term;
+  sigemptyset(&term);
+  sigaddset(&term, SIGTERM);
+  ::pthread_sigmask(SIG_BLOCK, &term, nullptr);
+  std::raise(SIGTERM);
+  try {
+    commitTogether({&a, &b});
+  } catch (const std::runtime_error&) {
+    ::pthread_sigmask(SIG_UNBLOCK, &term, nullptr);  // the signal, still pending, ends it here
+    std::_Exit(99);
+  }
+  ::pthread_sigmask(SIG_UNBLOCK, &term, nullptr);
+  std::_Exit(0);
+}
+
+TEST_F(AtomicFileTest, ASignalThatComesWhileTheFilesAreRenamedDoesNotUndoThem) {
+  EXPECT_EXIT(signalWhileRenaming(dir_, false), ::testing::ExitedWithCode(0), "");
+  EXPECT_EQ(slurp(path("a.csv")), "a\n");
+  EXPECT_EQ(slurp(path("b.csv")), "b\n");
+  fs::remove(path("a.csv"));
+  fs::remove(path("b.csv"));
+  EXPECT_EXIT(signalWhileRenaming(dir_, true), ::testing::ExitedWithCode(128 + SIGTERM), "");
+  EXPECT_EQ(listing(), std::vector<std::string>{"b.csv"});  // the directory; a.csv removed again
+  EXPECT_TRUE(fs::is_directory(path("b.csv")));
 }
 
 // A signal ignored by whoever started the program (nohup, trap '' HUP) stays ignored: the run

@@ -436,6 +436,44 @@ TEST_F(JackPlay, ALostServerEndsThePlayerWithTheRecordingComplete) {
   }
 }
 
+// The JACK server stopped (SIGSTOP) or hung while the player runs: closing the stream waits on
+// it. The player held SIGTERM, then a second one, for as long as the server stayed stopped, its
+// recording an unfinished temporary; now, 5 s after the signal (StopSignals::kGraceSeconds), or at
+// a second one, it completes the recording itself and ends without the server, saying so.
+TEST_F(JackPlay, AStoppedServerDoesNotHoldTheStopOrTheRecording) {
+  if (!onPath("jackd") || !onPath("jack_lsp"))
+    GTEST_SKIP() << "jackd (Debian's jackd2) is not installed";
+  for (const bool second : {false, true}) {
+    SCOPED_TRACE(second ? "a second signal" : "the grace period");
+    stopAll();
+    useServer(name_ + (second ? "-stopped2" : "-stopped1"));
+    ASSERT_NO_FATAL_FAILURE(startServer(false));
+    ASSERT_NO_FATAL_FAILURE(
+        startPlayer({"--preset", HAMILTONE_SOURCE_DIR "/presets/paper-c3-string.toml"}));
+    std::this_thread::sleep_for(500ms);  // something to record
+    jackd_->signal(SIGSTOP);
+    std::this_thread::sleep_for(200ms);
+    const Clock::time_point stop = Clock::now();
+    player_->signal(SIGTERM);
+    if (second) {
+      std::this_thread::sleep_for(1s);
+      player_->signal(SIGINT);
+    }
+    expectEndedWithTheRecording(player_, dir_, 0, "an audio server that is stopped or hung", 1);
+    const double took = std::chrono::duration<double>(Clock::now() - stop).count();
+    EXPECT_LT(took, second ? 4.0 : 15.0) << "ended " << took << " s after the signal";
+    jackd_->signal(SIGCONT);
+    jackd_->signal(SIGTERM);
+    jackd_->wait(10.0);
+    fs::remove(wav());
+    // The player ended without closing its client: the server's entry stays in JACK's registry
+    // (ALostServerEndsThePlayerWithTheRecordingComplete), until a server of its name frees it.
+    ASSERT_NO_FATAL_FAILURE(startServer(false));
+    jackd_->signal(SIGTERM);
+    EXPECT_EQ(jackd_->wait(10.0), 0) << slurp(dir_ / "jackd.err");
+  }
+}
+
 // The JACK server's buffer size changed while playing (jack_bufsize; PipeWire changes its quantum
 // by itself): RtAudio's stream cannot follow — it calls the player no more and reports only a
 // warning — and its stopStream() waits for a callback that never comes. The player played on in
