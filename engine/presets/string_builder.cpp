@@ -2,13 +2,17 @@
 // loss between the anchors, and which preset parameter each StringVoice field comes from.
 #include "presets/string_builder.h"
 
+#include <algorithm>
 #include <cmath>
 #include <exception>
 #include <numbers>
 #include <set>
+#include <stdexcept>
 #include <string>
 
+#include "instruments/piano_scale.h"
 #include "synth/instrument_body.h"
+#include "util/format_number.h"
 #include "voices/string_voice.h"
 
 namespace hamiltone {
@@ -54,6 +58,29 @@ constexpr VoiceField kStringFields[] = {
     {"hammer position", "hammer.position"},
     {"hammer width", "hammer.width_m"},
 };
+
+// A key's strings are tuned through their detune, within ±50 cents (StringVoice): their spread,
+// ±detune/2, and what the bridge's load pulls them (bridgeLoadCents) must fit in it.
+constexpr double kMaxTuningCents = 50.0;
+
+// The least bridge mass, from `key`'s (or a milligram) upwards in steps of 5 % up to 1000 kg,
+// whose load the tuning takes out at `hz`; 0 when none does.
+double massThatTunes(StringKey key, double hz) {
+  const double room = kMaxTuningCents - std::abs(key.detuneCents) / 2.0;
+  for (key.bridge.mass = std::max(key.bridge.mass, 1e-6); key.bridge.mass < 1e3;
+       key.bridge.mass *= 1.05) {
+    const double cents = bridgeLoadCents(key, hz);
+    if (std::isfinite(cents) && std::abs(cents) <= room) return key.bridge.mass;
+  }
+  return 0.0;
+}
+
+// The bridge's fields, for a message.
+std::string bridgeFields(const BridgePhysics& b) {
+  return "bridge.mass_kg = " + formatApprox(b.mass) +
+         ", bridge.stiffness_N_m = " + formatApprox(b.stiffness) +
+         ", bridge.resistance_kg_s = " + formatApprox(b.resistance);
+}
 
 }  // namespace
 
@@ -145,6 +172,22 @@ void checkStringVoices(const Instrument& instrument, const PresetValues& values,
   // The patches the synthesizer plays: the outermost unison strings carry the detune extremes.
   for (int note : notes) try {
       const StringKey& key = instrument.keys[note - lo];
+      // A bridge so light (or soft) that its load detunes the strings beyond what the tuning
+      // takes out is the bridge's fault, not the detune's the voice would name.
+      const double hz = equalTemperament(note, key.patch.a4Hz);
+      const double load = bridgeLoadCents(key, hz);
+      if (!std::isfinite(load) ||
+          std::abs(load) + std::abs(key.detuneCents) / 2.0 > kMaxTuningCents) {
+        const double mass = massThatTunes(key, hz);
+        throw std::invalid_argument(
+            bridgeFields(key.bridge) + ": the bridge's load moves the strings' pitch by " +
+            (std::isfinite(load) ? formatApprox(load) + " cents"
+                                 : std::string("more than an octave")) +
+            ", more than the tuning takes out (" + formatApprox(kMaxTuningCents) +
+            " cents, less half the unisons' detune); expected a heavier bridge" +
+            (mass > 0.0 ? " (bridge.mass_kg >= " + formatApprox(mass) + " with these)" : "") +
+            ", a stiffer one or more resistance");
+      }
       double added = 0.0;  // the outermost strings' K_s, the middle one's taken as theirs
       for (int string : {0, key.unisons - 1}) {
         StringVoice voice;

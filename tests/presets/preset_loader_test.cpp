@@ -592,6 +592,28 @@ TEST(PresetOverrides, AFeltWiderThanItsStringIsRefused) {
   EXPECT_NO_THROW(loadPreset(piano, {.overrides = {{"hammer.width_m", "0.011"}}}));
 }
 
+// A bridge so light that its load pulls the strings out of what the tuning takes out was refused
+// as a detune_cents the preset never set (-205 cents on paper-c3-string's F#2 at 10 g): the message
+// now names the bridge's fields, the load, and a mass that would do; 5e-324 kg too, whose load
+// is no number of cents, and whose search for that mass never ended (5 % of a denormal rounds to
+// it).
+TEST(PresetOverrides, ABridgeTooLightToTuneIsRefusedNamingTheBridge) {
+  const std::string paper = sourcePath("presets/paper-c3-string.toml");
+  for (const char* mass : {"0.01", "5e-324"}) {
+    const std::vector<std::string> lines =
+        errorsOf(paper, {.overrides = {{"bridge.mass_kg", mass}}});
+    ASSERT_FALSE(lines.empty()) << mass;
+    for (const std::string& line : lines)
+      EXPECT_THAT(line, AllOf(HasSubstr("bridge.mass_kg = "), HasSubstr("the bridge's load moves"),
+                              HasSubstr("expected a heavier bridge (bridge.mass_kg >= "),
+                              Not(HasSubstr("detune_cents"))))
+          << mass;
+  }
+  EXPECT_THAT(errorsOf(paper, {.overrides = {{"bridge.mass_kg", "0.01"}}}).front(),
+              HasSubstr("moves the strings' pitch by 205.3 cents"));
+  EXPECT_NO_THROW(loadPreset(paper, {.overrides = {{"bridge.mass_kg", "0.05"}}}));
+}
+
 // A grid the string cannot have (the longitudinal rule at the base rate makes h longer than the
 // treble strings) is the voices' refusal: each line names the setting the voice names and every
 // --set it was built with.
