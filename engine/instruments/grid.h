@@ -10,9 +10,10 @@
 namespace hamiltone {
 
 // floor(length / h), refused below 2 or above `maximum` with a message naming `what` (the
-// length's parameter) and `rule` (where h came from).
+// length's parameter) and `rule` (where h came from); `refinable`: h is above its bound (a grid
+// factor over 1), which a smaller factor brings closer.
 inline int segmentsAlong(double length, double h, double k, double maximum, const std::string& what,
-                         const std::string& rule) {
+                         const std::string& rule, bool refinable) {
   if (!(h > 0.0) || !std::isfinite(h))
     throw std::invalid_argument(
         what + " = " + formatNumber(length) + " m: the grid spacing h (" + rule +
@@ -24,7 +25,8 @@ inline int segmentsAlong(double length, double h, double k, double maximum, cons
     throw std::invalid_argument(
         what + " = " + formatNumber(length) + " m: shorter than two grid spacings h = " +
         formatApprox(h) + " m at k = " + formatApprox(k) + " s (" + rule +
-        "); use a smaller time step (oversampling) or a smaller grid factor");
+        "); use a smaller time step (a higher sample rate, or scheme.oversampling)" +
+        (refinable ? " or a smaller grid factor" : ""));
   if (segments > maximum)
     throw std::invalid_argument("the grid would have " + formatApprox(segments) +
                                 " segments along " + what + "; expected at most " +

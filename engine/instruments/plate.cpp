@@ -232,7 +232,7 @@ int plateSegments(const PlatePhysics& p, double length, double k, double factor,
   const double a = 16.0 * k * k * kappa * kappa, b = 8.0 * sigma1 * k;
   const double xMax = (-b + std::sqrt(b * b + 4.0 * a)) / (2.0 * a);  // the largest 1/h²
   const double h = factor / std::sqrt(xMax);
-  return segmentsAlong(length, h, k, 2000.0, "plate side", "bound (84)");
+  return segmentsAlong(length, h, k, 2000.0, "plate side", "bound (84)", factor > 1.0);
 }
 
 }  // namespace hamiltone

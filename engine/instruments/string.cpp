@@ -355,7 +355,8 @@ int gridSegments(const StringPhysics& p, GridRule rule, double k, double sigma1,
   const double h = factor * minimalSpacing(p, rule, k, sigma1);
   return segmentsAlong(
       p.length, h, k, 1e6, "length",
-      rule == GridRule::longitudinal ? "h >= sqrt(E/rho) k" : "stiff-string bound (44)");
+      rule == GridRule::longitudinal ? "h >= sqrt(E/rho) k" : "stiff-string bound (44)",
+      factor > (rule == GridRule::transverse ? kOffTheBound : 1.0));
 }
 
 StringGrid stringGrid(const StringPhysics& p, GridRule rule, double k, double sigma1, double factor,

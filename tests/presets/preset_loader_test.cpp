@@ -154,7 +154,7 @@ TEST(PresetLoader, BrokenFixturesGiveExactlyTheirErrors) {
       {"bad-unstable.toml",
        {"8:1: string.length_m = 0.02 at C3: shorter than two grid spacings h = "
         "0.01009 m at k = 2.083e-05 s (stiff-string bound (44)); use "
-        "a smaller time step (oversampling) or a smaller grid factor"}},
+        "a smaller time step (a higher sample rate, or scheme.oversampling)"}},
       {"bad-syntax.toml",
        {"2:16: syntax error: Error while parsing string: unescaped control characters other "
         "than TAB (U+0009) are explicitly prohibited"}},
@@ -633,7 +633,10 @@ TEST(PresetOverrides, VoiceCheckNamesTheSets) {
   EXPECT_THAT(errorsWith(kStringHead, {{"string.length_m", "0.02"}}),
               ElementsAre(AllOf(HasSubstr("test.toml: --set string.length_m=0.02 at C2: shorter "
                                           "than two grid spacings"),
-                                Not(HasSubstr("(with")))));
+                                Not(HasSubstr("(with")), Not(HasSubstr("grid factor")))));
+  // A smaller grid factor is advice only where the factor is above 1 (it cannot go below).
+  EXPECT_THAT(errorsWith(kStringHead, {{"string.length_m", "0.02"}, {"scheme.grid_factor", "2"}}),
+              ElementsAre(HasSubstr("or a smaller grid factor")));
 }
 
 TEST(PresetParameters, DefaultsSatisfyTheirOwnRanges) {
