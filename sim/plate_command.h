@@ -17,6 +17,7 @@ struct PlateArguments {
   std::string sigma0 = "0", sigma1 = "0";
   std::string snapshots, snapshotOut;  // "t1,t2,…" and the file of the whole fields
   std::string out;
+  bool allowLongRun = false;
 };
 
 CLI::App* addPlateCommand(CLI::App& app, PlateArguments& args);

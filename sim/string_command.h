@@ -18,6 +18,7 @@ struct StringArguments {
   std::string sigma0 = "0", sigma1 = "0";
   std::string snapshots, snapshotOut;  // "t1,t2,..." and the CSV of the whole string at those t
   std::string out;
+  bool allowLongRun = false;
 };
 
 CLI::App* addStringCommand(CLI::App& app, StringArguments& args);

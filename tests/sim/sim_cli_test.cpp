@@ -187,7 +187,10 @@ TEST_F(SimCli, RefusesARunThatWouldTakeTooLongUnlessAllowed) {
   const std::string fpu =
       "fpu --scheme sav --pairs 1000000 --k 1e-6 --duration 100 --every 1000000000";
   const std::string wave = "wave --dx 1e-6 --k 1e-7 --duration 10 --every 1000000000";
-  for (const std::string& args : {fpu, wave}) {
+  // The string and the plate started runs of a day or more without a word.
+  const std::string string = "string --segments 2000 --k 1e-10 --duration 1 --every 1000000000";
+  const std::string plate = "plate --k 1e-7 --duration 3 --every 1000000000";
+  for (const std::string& args : {fpu, wave, string, plate}) {
     for (const char* mention : {"days", "--allow-long-run", "per second"})
       expectRefused(args + " --out " + path("out.csv"), mention);
     expectRefused(args + " --allow-long-run --out " + path("no-dir/out.csv"), "--out");
@@ -197,6 +200,9 @@ TEST_F(SimCli, RefusesARunThatWouldTakeTooLongUnlessAllowed) {
       "--every 1000000000 --out " +
           path("out.csv"),
       "--allow-long-run");
+  expectRefused(
+      "plate --scheme implicit --k 1e-7 --duration 0.1 --every 1000000000 --out " + path("out.csv"),
+      "point²-steps");
 }
 
 TEST_F(SimCli, InterruptedRunLeavesNoFile) {
