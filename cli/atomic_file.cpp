@@ -66,8 +66,29 @@ extern "C" void removeTemporariesAndExit(int signal) {
     }
     if (state != kFailed) return;
   }
+  bool removed = false;
   for (Slot& slot : liveTemporaries)
-    if (slot.state.load() == kLive) ::unlink(slot.path);
+    if (slot.state.load() == kLive) removed = ::unlink(slot.path) == 0 || removed;
+  // "PROGRAM: stopped by SIGINT; its unfinished output removed", with async-signal-safe calls only.
+  char line[160];
+  std::size_t n = 0;
+  auto add = [&](const char* text) {
+    while (*text && n < sizeof line - 1) line[n++] = *text++;
+  };
+  add(program_invocation_short_name);
+  add(": stopped by ");
+  if (const char* name = ::sigabbrev_np(signal)) {
+    add("SIG");
+    add(name);
+  } else {
+    char digits[12];
+    int d = 0;
+    for (int v = signal; v > 0 && d < 11; v /= 10) digits[d++] = static_cast<char>('0' + v % 10);
+    add("signal ");
+    while (d > 0 && n < sizeof line - 1) line[n++] = digits[--d];
+  }
+  add(removed ? "; its unfinished output removed\n" : "\n");
+  [[maybe_unused]] const ssize_t written = ::write(STDERR_FILENO, line, n);
   ::_exit(128 + signal);
 }
 

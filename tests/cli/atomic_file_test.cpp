@@ -70,7 +70,8 @@ void reusedSlotThenSignal(const fs::path& dir, int signal) {
 }
 
 TEST_F(AtomicFileTest, SignalRemovesEveryLiveTemporary) {
-  EXPECT_EXIT(threeOpenThenSignal(dir_, SIGTERM), ::testing::ExitedWithCode(128 + SIGTERM), "");
+  EXPECT_EXIT(threeOpenThenSignal(dir_, SIGTERM), ::testing::ExitedWithCode(128 + SIGTERM),
+              ": stopped by SIGTERM; its unfinished output removed");
   EXPECT_TRUE(listing().empty());
   EXPECT_EXIT(reusedSlotThenSignal(dir_, SIGINT), ::testing::ExitedWithCode(128 + SIGINT), "");
   EXPECT_TRUE(listing().empty());
