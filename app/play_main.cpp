@@ -26,6 +26,7 @@
 #include "player.h"
 #include "preset_arguments.h"
 #include "recorder.h"
+#include "standard_output.h"
 #include "stop_signals.h"
 #include "usage_error.h"
 #include "version.h"
@@ -411,7 +412,9 @@ int play(const PlayArguments& a) {
 }  // namespace
 }  // namespace hamiltone::app
 
-int main(int argc, char** argv) {
+namespace {
+
+int runMain(int argc, char** argv) {
   using namespace hamiltone::app;
   namespace cli = hamiltone::cli;
   CLI::App app{"hamiltone-play: plays Hamiltone's physical models live from MIDI."};
@@ -498,4 +501,10 @@ int main(int argc, char** argv) {
     return 1;
   }
   return kExitUsage;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return hamiltone::cli::checkedStandardOutput("hamiltone-play", runMain(argc, argv));
 }

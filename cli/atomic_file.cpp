@@ -304,7 +304,10 @@ void AtomicFile::finish() {
   if (finished_) return;
   if (!file_) throw std::logic_error("AtomicFile::finish after a failed finish");
   errno = 0;
-  const bool written = std::fflush(file_) == 0 && !std::ferror(file_);
+  // On the disk before the rename makes it the file (fsync): otherwise a power cut soon after
+  // could leave the new name on an empty or partial file, where the old one was whole.
+  const bool written =
+      std::fflush(file_) == 0 && !std::ferror(file_) && ::fsync(::fileno(file_)) == 0;
   const int writeError = errno;
   const bool closed = std::fclose(file_) == 0;
   const int closeError = errno;

@@ -49,8 +49,9 @@ class AtomicFile {
   static const std::vector<int>& endingSignals();
 
   std::FILE* stream() { return file_; }
-  // Flushes and closes the temporary, keeping it; throws std::runtime_error on an I/O error (a
-  // full disk), after which the destructor removes it. The stream is gone afterwards.
+  // Flushes the temporary to the disk (fsync) and closes it, keeping it; throws
+  // std::runtime_error on an I/O error (a full disk), after which the destructor removes it. The
+  // stream is gone afterwards.
   void finish();
   // Renames the finished temporary onto the final path; throws std::runtime_error on failure.
   void publish();

@@ -19,6 +19,7 @@
 #include "preset_search.h"
 #include "presets/parameters.h"
 #include "progress_bar.h"
+#include "standard_output.h"
 #include "usage_error.h"
 #include "util/format_number.h"
 #include "version.h"
@@ -155,7 +156,9 @@ int run(const RenderArguments& a) {
 }  // namespace
 }  // namespace hamiltone::cli
 
-int main(int argc, char** argv) {
+namespace {
+
+int runMain(int argc, char** argv) {
   using namespace hamiltone::cli;
   CLI::App app{
       "hamiltone-render: plays a MIDI file or a list of notes on Hamiltone's physical models and "
@@ -215,4 +218,10 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "hamiltone-render: error: %s\n", e.what());
     return 1;
   }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return hamiltone::cli::checkedStandardOutput("hamiltone-render", runMain(argc, argv));
 }

@@ -9,13 +9,16 @@
 #include "fpu_command.h"
 #include "particle_command.h"
 #include "plate_command.h"
+#include "standard_output.h"
 #include "string_command.h"
 #include "usage_error.h"
 #include "version.h"
 #include "wave_command.h"
 #include "wave_inhomogeneous_command.h"
 
-int main(int argc, char** argv) {
+namespace {
+
+int runMain(int argc, char** argv) {
   using namespace hamiltone::cli;
   CLI::App app{
       "hamiltone-sim: runs the test problems of Bilbao, Ducceschi & Zama (2022) and "
@@ -60,4 +63,10 @@ int main(int argc, char** argv) {
     return 1;
   }
   return kExitUsage;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return hamiltone::cli::checkedStandardOutput("hamiltone-sim", runMain(argc, argv));
 }

@@ -88,6 +88,16 @@ TEST_F(PlayCli, RefusesToRecordOntoAPreset) {
   }
 }
 
+// --help (or --list-devices) to a full disk: exit 1, saying so, where it was lost with exit 0.
+TEST_F(PlayCli, AStandardOutputThatCannotBeWrittenIsAnIoError) {
+  const CommandResult r = hamiltone::testing::runCommand(
+      std::string("{ ") + HAMILTONE_PLAY + " --help >/dev/full; }", dir_ / "stderr");
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_NE(r.err.find("hamiltone-play: error: writing to standard output failed"),
+            std::string::npos)
+      << r.err;
+}
+
 // An empty --record or --virtual-midi was taken as no recording or no port, saying nothing; a
 // --record of another type than its extension names (a WAV written as take.flac) or of no type
 // the recorder writes is refused before any device, naming the extensions it takes.

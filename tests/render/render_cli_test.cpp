@@ -69,6 +69,20 @@ std::string preset(const char* name) {
   return std::string(HAMILTONE_SOURCE_DIR) + "/presets/" + name + ".toml";
 }
 
+// What hamiltone-render printed on standard output to a full disk was lost with exit code 0 (a
+// listing, --help, a summary): now exit 1, saying so, as for hamiltone-sim and hamiltone-play
+// (cli/standard_output.h; PlayCli has its own case). The group's own redirection would otherwise
+// send stdout to /dev/null: the inner one is the program's.
+TEST_F(RenderCli, AStandardOutputThatCannotBeWrittenIsAnIoError) {
+  for (const std::string& program : {std::string(HAMILTONE_RENDER) + " --list-params",
+                                     std::string(HAMILTONE_RENDER) + " --help"}) {
+    const Result r =
+        hamiltone::testing::runCommand("{ " + program + " >/dev/full; }", dir_ / "stderr");
+    EXPECT_EQ(r.exitCode, 1) << program << "\n" << r.err;
+    EXPECT_NE(r.err.find("writing to standard output failed"), std::string::npos) << r.err;
+  }
+}
+
 TEST_F(RenderCli, WritesTheRequestedRateChannelsFormatAndLength) {
   const Result r = run("--preset " + preset("paper-c3-string") +
                        " --notes C3:100:0.5 --tail 0.25 --sample-rate 44100 --format pcm16 "
