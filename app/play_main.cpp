@@ -213,7 +213,6 @@ int play(const PlayArguments& a) {
   pthread_sigmask(SIG_BLOCK, &stopSignals, nullptr);
   std::unique_ptr<Recorder> recorder;  // outlives the stop signals' thread, which may finish it
   StopSignals stops(stopSignals);
-  stops.setRecordPath(a.record);
 
   // Presets load and their voices are built here, off the audio thread; program change then only
   // switches between instruments that are ready.
@@ -389,15 +388,20 @@ int play(const PlayArguments& a) {
                    std::filesystem::exists(a.record) ? (a.record + " is as it was").c_str()
                                                      : (a.record + " was not written").c_str());
     } else if (!recorder->failed()) {
-      std::fprintf(stderr, "hamiltone-play: recorded %.2f s to %s%s%s\n", seconds, a.record.c_str(),
-                   s.recordDropped ? " (with gaps: the disk fell behind)" : "",
-                   recorder->truncatedFrames() ? " (cut at the 4 GiB a WAV file holds)" : "");
+      std::fprintf(
+          stderr, "hamiltone-play: recorded %.2f s to %s%s%s%s\n", seconds,
+          recorder->publishedPath().c_str(),
+          recorder->movedAside()
+              ? (" (beside " + a.record + ", which another program wrote meanwhile: kept)").c_str()
+              : "",
+          s.recordDropped ? " (with gaps: the disk fell behind)" : "",
+          recorder->truncatedFrames() ? " (cut at the 4 GiB a WAV file holds)" : "");
     } else if (recorder->kept()) {
       std::fprintf(stderr,
                    "hamiltone-play: error: the recording stopped at %.2f s (%s); %s holds the "
                    "%.2f s written before\n",
-                   recorder->failedAtSeconds(), recorder->error().c_str(), a.record.c_str(),
-                   seconds);
+                   recorder->failedAtSeconds(), recorder->error().c_str(),
+                   recorder->publishedPath().c_str(), seconds);
     } else {
       std::fprintf(stderr, "hamiltone-play: error: the recording failed (%s); no file written\n",
                    recorder->error().c_str());

@@ -11,7 +11,7 @@
 namespace hamiltone::app {
 
 Recorder::Recorder(const std::string& path, int sampleRate, cli::FileType type)
-    : wav_(path, "--record", sampleRate, 2, cli::SampleFormat::pcm24, type),
+    : wav_(path, "--record", sampleRate, 2, cli::SampleFormat::pcm24, type, true),
       ring_(static_cast<size_t>(kRingSeconds * sampleRate * 2)),
       maxFrames_(type == cli::FileType::wav ? kMaxFrames : std::numeric_limits<long>::max()),
       sampleRate_(sampleRate) {}

@@ -46,6 +46,10 @@ class Recorder {
   bool kept() const { return kept_; }
   bool empty() const { return finished_ && frames_ == 0 && !failed(); }
   const std::string& path() const { return wav_.path(); }
+  // After finish(): where the file is. A file another program wrote at the path meanwhile (a
+  // second player recording there) is kept, and this take goes beside it: take-2.wav.
+  const std::string& publishedPath() const { return wav_.publishedPath(); }
+  bool movedAside() const { return wav_.movedAside(); }
 
  private:
   void drain();

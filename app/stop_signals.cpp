@@ -81,7 +81,8 @@ void StopSignals::forceEnd(int signal, const char* why) {
     if (recorder->empty())
       std::snprintf(done, sizeof done, "nothing was recorded");
     else if (recorder->kept())
-      std::snprintf(done, sizeof done, "recorded %.2f s to %s%s%s", seconds, recordPath_.c_str(),
+      std::snprintf(done, sizeof done, "recorded %.2f s to %s%s%s", seconds,
+                    recorder->publishedPath().c_str(),
                     recorder->failed() ? " before the recording stopped: " : "",
                     recorder->failed() ? recorder->error().c_str() : "");
     else

@@ -31,8 +31,6 @@ class StopSignals {
   int wait(const timespec& timeout);
   // The recording to complete on a forced end (null: none). Set once it runs.
   void setRecorder(Recorder* recorder) { recorder_.store(recorder); }
-  // The recording's path, for the message.
-  void setRecordPath(std::string path) { recordPath_ = std::move(path); }
 
  private:
   void watch();
@@ -43,7 +41,6 @@ class StopSignals {
   std::atomic<int> signal_{-1};
   std::atomic<bool> ended_{false};
   std::atomic<Recorder*> recorder_{nullptr};
-  std::string recordPath_;
   std::thread thread_;
 };
 

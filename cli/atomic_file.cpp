@@ -2,6 +2,7 @@
 // is followed (its target is replaced, the link kept); a device or other special file is refused.
 #include "atomic_file.h"
 
+#include <fcntl.h>
 #include <pthread.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -227,11 +228,17 @@ void refuseInputAsOutput(const std::string& flag, const std::string& path,
                        input.path + ", which writing would destroy; expected another path");
 }
 
-AtomicFile::AtomicFile(std::string path, const std::string& flag) : path_(std::move(path)) {
+AtomicFile::AtomicFile(std::string path, const std::string& flag, bool keepOthers)
+    : path_(std::move(path)), keepOthers_(keepOthers) {
   if (path_.empty()) throw UsageError(flag + " is empty: expected a file path");
   mode_t mode = 0;
   struct stat existing {};
   if (::stat(path_.c_str(), &existing) == 0) {
+    existed_ = true;
+    device_ = existing.st_dev;
+    inode_ = existing.st_ino;
+    modified_ = existing.st_mtim;
+    size_ = existing.st_size;
     if (S_ISDIR(existing.st_mode))
       throw UsageError(flag + " = " + path_ + ": is a directory; expected a file path");
     if (!S_ISREG(existing.st_mode))
@@ -320,11 +327,49 @@ void AtomicFile::finish() {
   finished_ = true;
 }
 
+bool AtomicFile::writtenByAnother() const {
+  struct stat now {};
+  if (::stat(path_.c_str(), &now) != 0) return false;  // none there (or removed): nothing to keep
+  return !existed_ || now.st_dev != device_ || now.st_ino != inode_ || now.st_size != size_ ||
+         now.st_mtim.tv_sec != modified_.tv_sec || now.st_mtim.tv_nsec != modified_.tv_nsec;
+}
+
+// NAME-2.EXT, NAME-3.EXT, …: the first free one, taken without replacing (RENAME_NOREPLACE), so
+// that a file appearing meanwhile is not lost either.
+void AtomicFile::publishBeside() {
+  const std::filesystem::path target(path_);
+  const std::string stem = (target.parent_path() / target.stem()).string();
+  for (int n = 2; n < 1000; ++n) {
+    const std::string beside = stem + "-" + std::to_string(n) + target.extension().string();
+    if (::renameat2(AT_FDCWD, temporary_.c_str(), AT_FDCWD, beside.c_str(), RENAME_NOREPLACE) ==
+        0) {
+      path_ = beside;
+      movedAside_ = true;
+      return;
+    }
+    if (errno != EEXIST)
+      throw std::runtime_error("cannot move the output beside " + path_ + " (as " + beside +
+                               "): " + std::strerror(errno));
+  }
+  throw std::runtime_error("cannot move the output beside " + path_ +
+                           ": every name up to -999 is taken");
+}
+
 void AtomicFile::publish() {
   if (!finished_) throw std::logic_error("AtomicFile::publish before finish");
   if (temporary_.empty()) return;  // already published
-  if (std::rename(temporary_.c_str(), path_.c_str()) != 0)
+  if (keepOthers_ && writtenByAnother()) {
+    publishBeside();
+  } else if (keepOthers_ && !existed_) {  // none there: keep one that appears at the last moment
+    if (::renameat2(AT_FDCWD, temporary_.c_str(), AT_FDCWD, path_.c_str(), RENAME_NOREPLACE) != 0) {
+      if (errno != EEXIST)
+        throw std::runtime_error("cannot move the output onto " + path_ + ": " +
+                                 std::strerror(errno));
+      publishBeside();
+    }
+  } else if (std::rename(temporary_.c_str(), path_.c_str()) != 0) {
     throw std::runtime_error("cannot move the output onto " + path_ + ": " + std::strerror(errno));
+  }
   temporary_.clear();
   removeLive(slot_);
 }

@@ -1,7 +1,10 @@
 // An output file that appears whole or not at all: a temporary beside it, renamed on commit.
 #pragma once
 
+#include <sys/types.h>
+
 #include <cstdio>
+#include <ctime>
 #include <initializer_list>
 #include <string>
 #include <vector>
@@ -36,7 +39,11 @@ class AtomicFile {
   // came too late to stop the run, and the run ends as it would have.
   // The temporary is named PATH.tmp-PID-XXXXXX: one left by a run that could not clean up
   // (SIGKILL, a crash) is removed when a later run writes PATH and that PID is gone.
-  AtomicFile(std::string path, const std::string& flag);
+  //
+  // `keepOthers` (a recording, which cannot be made again): a file another program writes at the
+  // path while this one runs is kept, and this one is published beside it as NAME-2.EXT (or the
+  // next free number), which path() then names. Otherwise the last to publish replaces it.
+  AtomicFile(std::string path, const std::string& flag, bool keepOthers = false);
   ~AtomicFile();  // removes the temporary unless published
   AtomicFile(const AtomicFile&) = delete;
   AtomicFile& operator=(const AtomicFile&) = delete;
@@ -53,18 +60,31 @@ class AtomicFile {
   // std::runtime_error on an I/O error (a full disk), after which the destructor removes it. The
   // stream is gone afterwards.
   void finish();
-  // Renames the finished temporary onto the final path; throws std::runtime_error on failure.
+  // Renames the finished temporary onto the final path (or beside it: keepOthers); throws
+  // std::runtime_error on failure.
   void publish();
   // finish(), then publish().
   void commit();
 
   const std::string& path() const { return path_; }
+  // After publish(): whether the file went beside another program's (keepOthers).
+  bool movedAside() const { return movedAside_; }
 
  private:
+  // Whether the file at path_ is not the one there at construction (keepOthers).
+  bool writtenByAnother() const;
+  void publishBeside();
+
   std::string path_, temporary_;
   std::FILE* file_ = nullptr;
   int slot_ = -1;  // in the signal handler's table
   bool finished_ = false;
+  bool keepOthers_ = false, movedAside_ = false;
+  bool existed_ = false;  // at construction, with its identity:
+  dev_t device_ = 0;
+  ino_t inode_ = 0;
+  timespec modified_{};
+  off_t size_ = 0;
 };
 
 // Commits the files (null entries skipped) all or none: each is finished first, and only when

@@ -141,12 +141,12 @@ FileType fileTypeOf(const std::string& path, const std::string& flag) {
 }
 
 WavWriter::WavWriter(std::string path, const std::string& flag, int sampleRate, int channels,
-                     SampleFormat format, FileType type)
+                     SampleFormat format, FileType type, bool keepOthers)
     : path_(std::move(path)),
       sampleRate_(checkedSampleRate(sampleRate)),
       channels_(checkedChannels(channels)),
       type_(checkedType(type, format, sampleRate)),
-      file_(path_, flag) {
+      file_(path_, flag, keepOthers) {
   SF_INFO info{};
   info.samplerate = sampleRate_;
   info.channels = channels_;

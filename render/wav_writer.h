@@ -30,8 +30,9 @@ class WavWriter {
   // unwritable directory; std::invalid_argument for a sample rate <= 0 (or above kOggMaxRate for
   // Ogg), channels not 1 or 2, or FLAC in float32 (FLAC holds integers); std::runtime_error naming
   // the path if libsndfile refuses the format.
+  // `keepOthers`: as AtomicFile's (a recording).
   WavWriter(std::string path, const std::string& flag, int sampleRate, int channels,
-            SampleFormat format, FileType type = FileType::wav);
+            SampleFormat format, FileType type = FileType::wav, bool keepOthers = false);
   ~WavWriter();  // closes and removes the temporary unless committed
   WavWriter(const WavWriter&) = delete;
   WavWriter& operator=(const WavWriter&) = delete;
@@ -55,6 +56,9 @@ class WavWriter {
   std::size_t framesWritten() const { return written_; }
 
   const std::string& path() const { return path_; }
+  // Where commit() put the file: the path, or beside it (keepOthers).
+  const std::string& publishedPath() const { return file_.path(); }
+  bool movedAside() const { return file_.movedAside(); }
   int sampleRate() const { return sampleRate_; }
   int channels() const { return channels_; }
 

@@ -124,6 +124,51 @@ TEST_F(AtomicFileTest, ASignalThatComesWhileTheFilesAreRenamedDoesNotUndoThem) {
   EXPECT_TRUE(fs::is_directory(path("b.csv")));
 }
 
+// Two players recording to one path: the second to finish replaced the first's take, both saying
+// "recorded". With keepOthers (the recorder's) a file another program wrote at the path meanwhile
+// is kept and this one goes beside it (NAME-2.EXT, then -3 …), whether the path was free at the
+// start or held an older file; an older file nobody touched is replaced, as it always was; and
+// without keepOthers (a render) the last to publish replaces as before.
+TEST_F(AtomicFileTest, ARecordingKeepsAFileAnotherProgramWroteMeanwhile) {
+  const std::string take = path("take.wav");
+  auto write = [](const std::string& p, const char* text) { std::ofstream(p) << text; };
+  auto publish = [](AtomicFile& f, const char* text) {
+    std::fputs(text, f.stream());
+    f.commit();
+  };
+  {  // free at the start, written meanwhile
+    AtomicFile mine(take, "--record", true);
+    write(take, "theirs");
+    publish(mine, "mine");
+    EXPECT_TRUE(mine.movedAside());
+    EXPECT_EQ(mine.path(), path("take-2.wav"));
+  }
+  EXPECT_EQ(slurp(take), "theirs");
+  EXPECT_EQ(slurp(path("take-2.wav")), "mine");
+  {  // an older file there, rewritten meanwhile (another size): -2 is taken, so -3
+    AtomicFile mine(take, "--record", true);
+    write(take, "theirs, again");
+    publish(mine, "mine again");
+    EXPECT_EQ(mine.path(), path("take-3.wav"));
+  }
+  EXPECT_EQ(slurp(take), "theirs, again");
+  EXPECT_EQ(slurp(path("take-3.wav")), "mine again");
+  {  // an older file nobody touched: replaced
+    AtomicFile mine(take, "--record", true);
+    publish(mine, "a new take");
+    EXPECT_FALSE(mine.movedAside());
+  }
+  EXPECT_EQ(slurp(take), "a new take");
+  {  // a render: the last to publish replaces
+    AtomicFile out(take, "-o");
+    write(take, "theirs");
+    publish(out, "rendered");
+    EXPECT_FALSE(out.movedAside());
+  }
+  EXPECT_EQ(slurp(take), "rendered");
+  EXPECT_EQ(listing().size(), 3u);  // take, take-2, take-3: no temporary
+}
+
 // A signal ignored by whoever started the program (nohup, trap '' HUP) stays ignored: the run
 // goes on and its file appears. A signal not ignored still removes the temporaries.
 void ignoredHangupThenCommit(const fs::path& dir) {
