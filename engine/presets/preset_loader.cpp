@@ -106,8 +106,14 @@ std::string listChoices(std::string_view choices, bool quoted) {
   return out;
 }
 
+// "0.01 … inf", and the other parameter that bounds it: a value refused on its own range is then
+// not sent on to the other's (loss.t60_high_s = −1 read "expected 0.01 … inf", yet at most
+// loss.t60_low_s holds too).
 std::string rangeText(const Parameter& p) {
-  return compactNumber(p.min) + " … " + compactNumber(p.max);
+  std::string text = compactNumber(p.min) + " … " + compactNumber(p.max);
+  if (!p.minOf.empty()) text += ", and at least " + std::string(p.minOf);
+  if (!p.maxOf.empty()) text += ", and at most " + std::string(p.maxOf);
+  return text;
 }
 
 char lower(char c) { return c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c; }

@@ -614,6 +614,14 @@ TEST(PresetOverrides, ABridgeTooLightToTuneIsRefusedNamingTheBridge) {
   EXPECT_NO_THROW(loadPreset(paper, {.overrides = {{"bridge.mass_kg", "0.05"}}}));
 }
 
+// A value out of its own range names the parameter that bounds it too: loss.t60_high_s = −1 read
+// "expected 0.01 … inf", though it must be at most loss.t60_low_s as well.
+TEST(PresetOverrides, ARangeNamesTheParameterThatBoundsItToo) {
+  EXPECT_THAT(errorsOf(sourcePath("presets/paper-c3-string.toml"),
+                       {.overrides = {{"loss.t60_high_s", "-1"}}}),
+              ElementsAre(HasSubstr("expected 0.01 … inf, and at most loss.t60_low_s")));
+}
+
 // A grid the string cannot have (the longitudinal rule at the base rate makes h longer than the
 // treble strings) is the voices' refusal: each line names the setting the voice names and every
 // --set it was built with.
