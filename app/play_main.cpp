@@ -240,6 +240,7 @@ int play(const PlayArguments& a) {
                             std::to_string(cli::kOggMaxRate) + " Hz, and the stream runs at " +
                             std::to_string(rate) + " Hz; record to a .wav or .flac file");
     recorder = std::make_unique<Recorder>(a.record, static_cast<int>(rate), recordType);
+    stops.setRecorder(recorder.get());  // from its temporary on: a forced end removes it
   }
   Player player(synth, midi.queue(), recorder ? &recorder->ring() : nullptr, rate, 8192,
                 cpuLimit / 100.0);
@@ -257,10 +258,7 @@ int play(const PlayArguments& a) {
     midi.openPort(static_cast<int>(cli::parseInteger("--midi-port", a.midiPort, 0)));
   else if (score.what.empty() || a.keepListening)
     warnNoMidiInput(midi);
-  if (recorder) {
-    recorder->start();
-    stops.setRecorder(recorder.get());
-  }
+  if (recorder) recorder->start();
   audio.start();
 
   const bool status = !a.quiet && ::isatty(2);
@@ -361,6 +359,7 @@ int play(const PlayArguments& a) {
   // client, crashed the player here once, in libjack's latency recompute, and lost its recording.
   midi.close();
   audio.stop();
+  stops.released();
   const Player::Status s = player.status();
   if (status) std::fprintf(stderr, "\n");
   if (lost)

@@ -61,11 +61,16 @@ double Recorder::finish() noexcept {
     stopping_ = true;
     if (writer_.joinable()) writer_.join();
     finished_ = true;
-    if (frames_ == 0 && !failed()) return 0.0;  // the temporary goes with wav_
+    // No temporary outlives finish(): the stop signals' thread may end the program by _exit.
+    if (frames_ == 0 && !failed()) {
+      wav_.discard();
+      return 0.0;
+    }
     try {
       wav_.commit();
       kept_ = true;
     } catch (const std::exception& e) {
+      wav_.discard();
       // The temporary goes with wav_; say why, after the first error if there was one.
       error_ = failed() ? error_ + "; then " + e.what() : std::string(e.what());
       failed_.store(true, std::memory_order_release);

@@ -61,6 +61,7 @@ void StopSignals::watch() {
   timespec first{};
   while (!ended_.load()) {
     const int s = ::sigtimedwait(&signals_, nullptr, &kPoll);
+    if (released_.load()) continue;
     if (s > 0 && signal_.load() < 0) {
       signal_.store(s);
       ::clock_gettime(CLOCK_MONOTONIC, &first);

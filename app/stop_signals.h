@@ -29,8 +29,12 @@ class StopSignals {
 
   // Waits up to `timeout` for the first signal; returns it, or −1.
   int wait(const timespec& timeout);
-  // The recording to complete on a forced end (null: none). Set once it runs.
+  // The recording to complete on a forced end (null: none), from its temporary's creation.
   void setRecorder(Recorder* recorder) { recorder_.store(recorder); }
+  // The stream is closed: nothing is left that a hung server could hold, and what the main thread
+  // does now (the recording's last write and fsync, which a slow disk can stretch past the grace
+  // period) is left to it.
+  void released() { released_.store(true); }
 
  private:
   void watch();
@@ -39,7 +43,7 @@ class StopSignals {
   sigset_t signals_;
   sem_t first_;  // posted once, at the first signal
   std::atomic<int> signal_{-1};
-  std::atomic<bool> ended_{false};
+  std::atomic<bool> ended_{false}, released_{false};
   std::atomic<Recorder*> recorder_{nullptr};
   std::thread thread_;
 };

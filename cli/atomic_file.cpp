@@ -150,7 +150,8 @@ int addLive(const std::string& path) {
     if (!liveTemporaries[i].state.compare_exchange_strong(expected, kFilling)) continue;
     std::memcpy(liveTemporaries[i].path, path.c_str(), path.size() + 1);
     liveTemporaries[i].state.store(kLive);
-    publishing.store(kWriting);  // after a failed publish: a signal ends the run again
+    int failed = kFailed;  // after a failed publish a signal ends the run again; a publish that
+    publishing.compare_exchange_strong(failed, kWriting);  // another thread runs stays one
     installHandler();
     return i;
   }
@@ -301,9 +302,13 @@ AtomicFile::AtomicFile(std::string path, const std::string& flag, bool keepOther
   }
 }
 
-AtomicFile::~AtomicFile() {
+AtomicFile::~AtomicFile() { discard(); }
+
+void AtomicFile::discard() {
   if (file_) std::fclose(file_);
+  file_ = nullptr;
   if (!temporary_.empty()) std::remove(temporary_.c_str());
+  temporary_.clear();
   removeLive(slot_);
 }
 
@@ -334,22 +339,43 @@ bool AtomicFile::writtenByAnother() const {
          now.st_mtim.tv_sec != modified_.tv_sec || now.st_mtim.tv_nsec != modified_.tv_nsec;
 }
 
-// NAME-2.EXT, NAME-3.EXT, …: the first free one, taken without replacing (RENAME_NOREPLACE), so
-// that a file appearing meanwhile is not lost either.
+namespace {
+
+// rename(2) that never replaces: 0, or the errno (EEXIST: a file is there). Where the file system
+// takes no rename flags (NFS, 9p, FUSE without rename2: EINVAL; an old kernel: ENOSYS), a hard
+// link does the same (link(2) never replaces either); where it has no hard links (vfat), a check
+// and a plain rename, which a file appearing between the two would lose.
+int renameNoReplace(const char* from, const char* to) {
+  if (::renameat2(AT_FDCWD, from, AT_FDCWD, to, RENAME_NOREPLACE) == 0) return 0;
+  if (errno != EINVAL && errno != ENOSYS && errno != EOPNOTSUPP) return errno;
+  if (::link(from, to) == 0) {
+    ::unlink(from);
+    return 0;
+  }
+  if (errno == EEXIST) return EEXIST;
+  struct stat there {};
+  if (::lstat(to, &there) == 0) return EEXIST;
+  return std::rename(from, to) == 0 ? 0 : errno;
+}
+
+}  // namespace
+
+// NAME-2.EXT, NAME-3.EXT, …: the first free one, taken without replacing, so that a file
+// appearing meanwhile is not lost either.
 void AtomicFile::publishBeside() {
   const std::filesystem::path target(path_);
   const std::string stem = (target.parent_path() / target.stem()).string();
   for (int n = 2; n < 1000; ++n) {
     const std::string beside = stem + "-" + std::to_string(n) + target.extension().string();
-    if (::renameat2(AT_FDCWD, temporary_.c_str(), AT_FDCWD, beside.c_str(), RENAME_NOREPLACE) ==
-        0) {
+    const int error = renameNoReplace(temporary_.c_str(), beside.c_str());
+    if (error == 0) {
       path_ = beside;
       movedAside_ = true;
       return;
     }
-    if (errno != EEXIST)
+    if (error != EEXIST)
       throw std::runtime_error("cannot move the output beside " + path_ + " (as " + beside +
-                               "): " + std::strerror(errno));
+                               "): " + std::strerror(error));
   }
   throw std::runtime_error("cannot move the output beside " + path_ +
                            ": every name up to -999 is taken");
@@ -361,11 +387,12 @@ void AtomicFile::publish() {
   if (keepOthers_ && writtenByAnother()) {
     publishBeside();
   } else if (keepOthers_ && !existed_) {  // none there: keep one that appears at the last moment
-    if (::renameat2(AT_FDCWD, temporary_.c_str(), AT_FDCWD, path_.c_str(), RENAME_NOREPLACE) != 0) {
-      if (errno != EEXIST)
-        throw std::runtime_error("cannot move the output onto " + path_ + ": " +
-                                 std::strerror(errno));
+    const int error = renameNoReplace(temporary_.c_str(), path_.c_str());
+    if (error == EEXIST) {
       publishBeside();
+    } else if (error != 0) {
+      throw std::runtime_error("cannot move the output onto " + path_ + ": " +
+                               std::strerror(error));
     }
   } else if (std::rename(temporary_.c_str(), path_.c_str()) != 0) {
     throw std::runtime_error("cannot move the output onto " + path_ + ": " + std::strerror(errno));

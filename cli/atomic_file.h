@@ -65,6 +65,9 @@ class AtomicFile {
   void publish();
   // finish(), then publish().
   void commit();
+  // Closes and removes the temporary now, as the destructor would: for a program about to end by
+  // _exit, which runs no destructor. Nothing is published after it.
+  void discard();
 
   const std::string& path() const { return path_; }
   // After publish(): whether the file went beside another program's (keepOthers).

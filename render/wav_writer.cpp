@@ -176,6 +176,12 @@ WavWriter::~WavWriter() {
   if (sound_) sf_close(sound_);
 }
 
+void WavWriter::discard() {
+  if (sound_) sf_close(sound_);
+  sound_ = nullptr;
+  file_.discard();
+}
+
 void WavWriter::write(const float* interleaved, std::size_t frames) {
   if (!sound_) throw std::logic_error("WavWriter::write after commit: " + path_);
   while (frames > 0) {

@@ -52,6 +52,8 @@ class WavWriter {
   // is a valid WAV of what was written before the failure; a compressed file cannot be cut, so
   // then commit() throws and nothing appears.
   void commit();
+  // Closes and removes the temporary now (AtomicFile::discard); nothing is written after it.
+  void discard();
 
   std::size_t framesWritten() const { return written_; }
 

@@ -142,7 +142,7 @@ int runPlateCommand(const PlateArguments& a) {
 
   const int mx = building([&] { return plateSegments(physics, physics.lx, k, factor, sigma1); });
   const int my = building([&] { return plateSegments(physics, physics.ly, k, factor, sigma1); });
-  // Measured (one core, a 2-core Zen 5): sav-split and sv about 6e7 point-steps a second (142 ×
+  // Measured (one core, a 2-core Zen 5): sav-split and sv about 5e7 point-steps a second (142 ×
   // 142 points); the implicit reference's Newton solves grow as the square of the points: about
   // 5e8 point²-steps a second (30 × 30 to 142 × 142).
   const double points = static_cast<double>(mx - 1) * static_cast<double>(my - 1);
