@@ -41,6 +41,11 @@ std::vector<PresetOverride> parseSets(const std::vector<std::string>& sets) {
 
 std::vector<Instrument> loadPresets(const std::vector<std::string>& files,
                                     const std::vector<std::string>& sets, double checkRate) {
+  // MIDI program change selects one of 128: a preset past them could never be played.
+  if (files.size() > 128)
+    throw UsageError("--preset given " + std::to_string(files.size()) +
+                     " times: MIDI program change reaches 128 presets (programs 0 … 127); "
+                     "expected at most 128");
   PresetOptions options;
   options.checkRate = checkRate;
   options.overrides = parseSets(sets);

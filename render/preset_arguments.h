@@ -21,7 +21,8 @@ std::vector<PresetOverride> parseSets(const std::vector<std::string>& sets);
 // Every file (or preset name, resolvePreset) loaded with every --set over it
 // (PresetOptions::overrides), its voices checked at `checkRate` (the rate they will play at, when
 // known); UsageError "bad preset:" with every error line of every file, or of a malformed --set,
-// or for the first name that names no preset.
+// or for the first name that names no preset; UsageError for more than 128 files, more than
+// program change reaches.
 std::vector<Instrument> loadPresets(const std::vector<std::string>& files,
                                     const std::vector<std::string>& sets,
                                     double checkRate = kCheckRate);

@@ -11,7 +11,7 @@ namespace hamiltone::cli {
 struct WaveInhomogeneousArguments {
   std::string dx = "5e-4", ratio = "10", duration = "0.5";
   std::string quadrature = "midpoint", start = "paper";
-  bool sync = false;
+  bool sync = false, allowLongRun = false;
   std::string out;
 };
 

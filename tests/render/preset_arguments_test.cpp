@@ -70,6 +70,12 @@ TEST(PresetArguments, EveryPresetsRefusalIsGathered) {
                 "is \"plate\"");
 }
 
+// 130 presets were taken without a word, though program change reaches 128 of them.
+TEST(PresetArguments, MoreThanProgramChangeReachesIsRefused) {
+  const std::vector<std::string> many(129, preset("steel-plate"));
+  EXPECT_NE(errorOf(many, {}).find("--preset given 129 times"), std::string::npos);
+}
+
 }  // namespace
 
 namespace {

@@ -203,6 +203,10 @@ TEST_F(SimCli, RefusesARunThatWouldTakeTooLongUnlessAllowed) {
   expectRefused(
       "plate --scheme implicit --k 1e-7 --duration 0.1 --every 1000000000 --out " + path("out.csv"),
       "point²-steps");
+  // Under its cap of 1e12 particle-steps, yet over an hour (about 1.1 h at midpoint): it ran on.
+  for (const char* mention : {"1.111 h", "--allow-long-run"})
+    expectRefused("wave-inhomogeneous --dx 1e-7 --duration 0.001 --out " + path("out.csv"),
+                  mention);
 }
 
 TEST_F(SimCli, InterruptedRunLeavesNoFile) {
