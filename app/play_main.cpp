@@ -382,29 +382,8 @@ int play(const PlayArguments& a) {
                  s.limiterDeepestDb, s.limitedFrames);
   if (recorder) {
     const double seconds = recorder->finish();
-    if (recorder->empty()) {
-      std::fprintf(stderr, "hamiltone-play: nothing was recorded (no audio was played); %s\n",
-                   std::filesystem::exists(a.record) ? (a.record + " is as it was").c_str()
-                                                     : (a.record + " was not written").c_str());
-    } else if (!recorder->failed()) {
-      std::fprintf(
-          stderr, "hamiltone-play: recorded %.2f s to %s%s%s%s\n", seconds,
-          recorder->publishedPath().c_str(),
-          recorder->movedAside()
-              ? (" (beside " + a.record + ", which another program wrote meanwhile: kept)").c_str()
-              : "",
-          s.recordDropped ? " (with gaps: the disk fell behind)" : "",
-          recorder->truncatedFrames() ? " (cut at the 4 GiB a WAV file holds)" : "");
-    } else if (recorder->kept()) {
-      std::fprintf(stderr,
-                   "hamiltone-play: error: the recording stopped at %.2f s (%s); %s holds the "
-                   "%.2f s written before\n",
-                   recorder->failedAtSeconds(), recorder->error().c_str(),
-                   recorder->publishedPath().c_str(), seconds);
-    } else {
-      std::fprintf(stderr, "hamiltone-play: error: the recording failed (%s); no file written\n",
-                   recorder->error().c_str());
-    }
+    std::fprintf(stderr, "hamiltone-play: %s%s\n", recorder->failed() ? "error: " : "",
+                 recorder->outcome(seconds, s.recordDropped).c_str());
     if (recorder->failed()) return 1;
   }
   if (lost) return kExitAudioLost;

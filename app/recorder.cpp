@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <exception>
+#include <filesystem>
 #include <limits>
 #include <vector>
 
@@ -71,12 +73,35 @@ double Recorder::finish() noexcept {
       kept_ = true;
     } catch (const std::exception& e) {
       wav_.discard();
-      // The temporary goes with wav_; say why, after the first error if there was one.
+      // Say why, after the first error if there was one.
       error_ = failed() ? error_ + "; then " + e.what() : std::string(e.what());
       failed_.store(true, std::memory_order_release);
     }
   }
   return kept_ ? static_cast<double>(frames_) / sampleRate_ : 0.0;
+}
+
+std::string Recorder::outcome(double seconds, bool gaps) const {
+  char line[256];
+  if (empty()) {
+    return "nothing was recorded (no audio was played); " + path() +
+           (std::filesystem::exists(path()) ? " is as it was" : " was not written");
+  }
+  if (!failed()) {
+    std::snprintf(line, sizeof line, "recorded %.2f s to ", seconds);
+    return line + publishedPath() +
+           (movedAside() ? " (beside " + path() + ", which another program wrote meanwhile: kept)"
+                         : "") +
+           (gaps ? " (with gaps: the disk fell behind)" : "") +
+           (truncatedFrames() ? " (cut at the 4 GiB a WAV file holds)" : "");
+  }
+  if (kept()) {
+    std::snprintf(line, sizeof line, "the recording stopped at %.2f s (", failedAtSeconds());
+    std::string text = line + error() + "); " + publishedPath();
+    std::snprintf(line, sizeof line, " holds the %.2f s written before", seconds);
+    return text + line;
+  }
+  return "the recording failed (" + error() + "); no file written";
 }
 
 }  // namespace hamiltone::app

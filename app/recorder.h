@@ -29,12 +29,15 @@ class Recorder {
   void start();
   // Stops the writer once the ring is drained and renames the file into place: after a write
   // error, the frames written before it (a valid WAV), or no file if even that fails (then the
-  // temporary is removed). From any thread, one at a time (the stop signals' thread completes
-  // the recording when the audio server hangs); a second call returns what the first did. A
-  // recording of no frame at all (the stream never ran) is not put in
-  // place either: a file already at the path stays as it was. Never throws. Returns the seconds
-  // in the file (0 when there is none).
+  // temporary is removed). A recording of no frame at all (the stream never ran) is not put in
+  // place either: a file already at the path stays as it was. From any thread, one at a time
+  // (the stop signals' thread completes the recording when the audio server hangs); a second
+  // call returns what the first did. Never throws. Returns the seconds in the file (0 when there
+  // is none).
   double finish() noexcept;
+  // After finish(), what became of the recording, for the player's last line: "recorded 2.50 s
+  // to take.wav", "the recording failed (…); no file written", …; `gaps`: the ring overflowed.
+  std::string outcome(double seconds, bool gaps) const;
   long truncatedFrames() const { return truncated_; }  // past kMaxFrames, not written
 
   // Whether a write failed; from any thread. The recording stopped there.

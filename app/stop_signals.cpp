@@ -76,25 +76,15 @@ void StopSignals::watch() {
 
 void StopSignals::forceEnd(int signal, const char* why) {
   int code = stopExitCode(signal);
-  char done[512] = "nothing to record";
+  std::string done = "nothing to record";
   if (Recorder* recorder = recorder_.load()) {
-    const double seconds = recorder->finish();
-    if (recorder->empty())
-      std::snprintf(done, sizeof done, "nothing was recorded");
-    else if (recorder->kept())
-      std::snprintf(done, sizeof done, "recorded %.2f s to %s%s%s", seconds,
-                    recorder->publishedPath().c_str(),
-                    recorder->failed() ? " before the recording stopped: " : "",
-                    recorder->failed() ? recorder->error().c_str() : "");
-    else
-      std::snprintf(done, sizeof done, "the recording failed (%s); no file written",
-                    recorder->error().c_str());
+    done = recorder->outcome(recorder->finish(), false);
     if (recorder->failed()) code = 1;
   }
   std::fprintf(stderr,
                "\nhamiltone-play: stopped by %s, but %s: an audio server that is stopped or hung "
                "holds the stream; %s; ending without waiting for it\n",
-               signalName(signal).c_str(), why, done);
+               signalName(signal).c_str(), why, done.c_str());
   std::fflush(stderr);
   ::_exit(code);
 }

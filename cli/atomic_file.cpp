@@ -236,10 +236,7 @@ AtomicFile::AtomicFile(std::string path, const std::string& flag, bool keepOther
   struct stat existing {};
   if (::stat(path_.c_str(), &existing) == 0) {
     existed_ = true;
-    device_ = existing.st_dev;
-    inode_ = existing.st_ino;
-    modified_ = existing.st_mtim;
-    size_ = existing.st_size;
+    before_ = existing;
     if (S_ISDIR(existing.st_mode))
       throw UsageError(flag + " = " + path_ + ": is a directory; expected a file path");
     if (!S_ISREG(existing.st_mode))
@@ -335,8 +332,9 @@ void AtomicFile::finish() {
 bool AtomicFile::writtenByAnother() const {
   struct stat now {};
   if (::stat(path_.c_str(), &now) != 0) return false;  // none there (or removed): nothing to keep
-  return !existed_ || now.st_dev != device_ || now.st_ino != inode_ || now.st_size != size_ ||
-         now.st_mtim.tv_sec != modified_.tv_sec || now.st_mtim.tv_nsec != modified_.tv_nsec;
+  return !existed_ || now.st_dev != before_.st_dev || now.st_ino != before_.st_ino ||
+         now.st_size != before_.st_size || now.st_mtim.tv_sec != before_.st_mtim.tv_sec ||
+         now.st_mtim.tv_nsec != before_.st_mtim.tv_nsec;
 }
 
 namespace {

@@ -1,10 +1,9 @@
 // An output file that appears whole or not at all: a temporary beside it, renamed on commit.
 #pragma once
 
-#include <sys/types.h>
+#include <sys/stat.h>
 
 #include <cstdio>
-#include <ctime>
 #include <initializer_list>
 #include <string>
 #include <vector>
@@ -83,11 +82,8 @@ class AtomicFile {
   int slot_ = -1;  // in the signal handler's table
   bool finished_ = false;
   bool keepOthers_ = false, movedAside_ = false;
-  bool existed_ = false;  // at construction, with its identity:
-  dev_t device_ = 0;
-  ino_t inode_ = 0;
-  timespec modified_{};
-  off_t size_ = 0;
+  bool existed_ = false;  // a file at the path at construction, and its stat:
+  struct stat before_ {};
 };
 
 // Commits the files (null entries skipped) all or none: each is finished first, and only when

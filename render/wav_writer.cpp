@@ -172,9 +172,7 @@ WavWriter::WavWriter(std::string path, const std::string& flag, int sampleRate, 
   chunk_.resize(kChunkFrames * static_cast<std::size_t>(channels_));
 }
 
-WavWriter::~WavWriter() {
-  if (sound_) sf_close(sound_);
-}
+WavWriter::~WavWriter() { discard(); }
 
 void WavWriter::discard() {
   if (sound_) sf_close(sound_);

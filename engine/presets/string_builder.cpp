@@ -59,14 +59,12 @@ constexpr VoiceField kStringFields[] = {
     {"hammer width", "hammer.width_m"},
 };
 
-// A key's strings are tuned through their detune, within ±50 cents (StringVoice): their spread,
-// ±detune/2, and what the bridge's load pulls them (bridgeLoadCents) must fit in it.
-constexpr double kMaxTuningCents = 50.0;
-
+// A key's strings are tuned through their detune, within ±kMaxDetuneCents (StringVoice): their
+// spread, ±detune/2, and what the bridge's load pulls them (bridgeLoadCents) must fit in it.
 // The least bridge mass, from `key`'s (or a milligram) upwards in steps of 5 % up to 1000 kg,
 // whose load the tuning takes out at `hz`; 0 when none does.
 double massThatTunes(StringKey key, double hz) {
-  const double room = kMaxTuningCents - std::abs(key.detuneCents) / 2.0;
+  const double room = kMaxDetuneCents - std::abs(key.detuneCents) / 2.0;
   for (key.bridge.mass = std::max(key.bridge.mass, 1e-6); key.bridge.mass < 1e3;
        key.bridge.mass *= 1.05) {
     const double cents = bridgeLoadCents(key, hz);
@@ -177,13 +175,13 @@ void checkStringVoices(const Instrument& instrument, const PresetValues& values,
       const double hz = equalTemperament(note, key.patch.a4Hz);
       const double load = bridgeLoadCents(key, hz);
       if (!std::isfinite(load) ||
-          std::abs(load) + std::abs(key.detuneCents) / 2.0 > kMaxTuningCents) {
+          std::abs(load) + std::abs(key.detuneCents) / 2.0 > kMaxDetuneCents) {
         const double mass = massThatTunes(key, hz);
         throw std::invalid_argument(
             bridgeFields(key.bridge) + ": the bridge's load moves the strings' pitch by " +
             (std::isfinite(load) ? formatApprox(load) + " cents"
                                  : std::string("more than an octave")) +
-            ", more than the tuning takes out (" + formatApprox(kMaxTuningCents) +
+            ", more than the tuning takes out (" + formatApprox(kMaxDetuneCents) +
             " cents, less half the unisons' detune); expected a heavier bridge" +
             (mass > 0.0 ? " (bridge.mass_kg >= " + formatApprox(mass) + " with these)" : "") +
             ", a stiffer one or more resistance");

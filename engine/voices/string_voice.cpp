@@ -228,8 +228,8 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
   // Everything is built in locals and committed only once nothing more can throw, so a failed
   // prepare() leaves the voice as it was.
   const double k = 1.0 / (sampleRate * r);
-  require(std::isfinite(patch.detuneCents) && std::abs(patch.detuneCents) <= 50.0, "detune_cents",
-          patch.detuneCents, "between −50 and 50 cents");
+  require(std::isfinite(patch.detuneCents) && std::abs(patch.detuneCents) <= kMaxDetuneCents,
+          "detune_cents", patch.detuneCents, "between −50 and 50 cents");
   const double target =
       equalTemperament(midiNote, patch.a4Hz) * std::pow(2.0, patch.detuneCents / 1200.0);
   // Oversampling runs the string faster, but the output cannot carry a fundamental above its own

@@ -61,6 +61,8 @@ struct StringPatch {
 
 // loss.damper_t60_s's largest value: the preset's "no damper" (the keys from F6 up).
 constexpr double kNoDamperT60 = 1000.0;  // s
+// The most a string is detuned from its note, cents: its unison spread and its bridge's load.
+constexpr double kMaxDetuneCents = 50.0;
 
 constexpr double kEpsilonShare = 0.1;
 // On a grid that does not resolve the longitudinal wave, the largest ε as a share of that energy.
