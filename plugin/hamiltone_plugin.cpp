@@ -166,7 +166,7 @@ class HamiltonePlugin : public Plugin {
        "",
        {0.0f, 0.0f, 2.0f},
        "0 loading, 1 ready, 2 the preset or overrides were refused (the reason is on stderr; the "
-       "instrument before plays on)."},
+       "instrument before plays on, or with none before, a bundled one)."},
   };
 
   // An enumeration of `labels`, valued 0, 1, …

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <optional>
 #include <stdexcept>
@@ -111,16 +112,42 @@ void SynthLoader::build(const SynthRecipe& recipe) {
     }
     outcome_.store(LoadStatus::ready, std::memory_order_release);
     status_.store(LoadStatus::ready, std::memory_order_release);
+    playable_ = true;
   } catch (const std::exception& e) {
+    // Hosts keep a plugin's stderr in their log. The synthesizer playing before plays on; with
+    // none (a session restored on a machine without its preset file), a bundled one stands in.
+    std::string why = e.what();
+    if (!playable_) why += standIn(recipe);
     {
       const std::lock_guard lock(mutex_);
-      error_ = e.what();
+      error_ = why;
     }
     outcome_.store(LoadStatus::failed, std::memory_order_release);
     status_.store(LoadStatus::failed, std::memory_order_release);
-    // Hosts keep a plugin's stderr in their log; the synthesizer playing before plays on.
-    std::fprintf(stderr, "hamiltone plugin: %s\n", e.what());
+    std::fprintf(stderr, "hamiltone plugin: %s\n", why.c_str());
   }
+}
+
+// The bundled preset the recipe's index names (the first, if it names none), then the others in
+// their order, each without file or overrides: the first that builds is left for take().
+std::string SynthLoader::standIn(const SynthRecipe& refused) {
+  const auto presets = bundledPresets();
+  const int count = static_cast<int>(presets.size());
+  const int first = refused.bundled >= 0 && refused.bundled < count ? refused.bundled : 0;
+  for (int i = 0; i < count; ++i) {
+    const SynthRecipe candidate{.bundled = (first + i) % count, .sampleRate = refused.sampleRate};
+    if (candidate == refused) continue;  // refused already
+    try {
+      delete built_.exchange(buildSynth(candidate).release(), std::memory_order_acq_rel);
+      playable_ = true;
+      return std::string("; playing the bundled \"") + presets[candidate.bundled].name +
+             "\" until a preset that builds is chosen";
+    } catch (const std::exception&) {
+      continue;  // the next (at this rate some presets cannot be built)
+    }
+  }
+  return "; no bundled preset builds at " + std::to_string(std::lround(refused.sampleRate)) +
+         " Hz either: silent until one that does is chosen";
 }
 
 void SynthLoader::freeGivenBack() {
@@ -135,6 +162,7 @@ void SynthLoader::start(double sampleRate) {
     sampleRate_ = sampleRate;
     stopping_ = false;
     recipe = attempted_ = wanted();
+    playable_ = false;  // deactivate freed what played
   }
   build(recipe);
   thread_ = std::thread(&SynthLoader::run, this);

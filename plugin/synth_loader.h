@@ -66,7 +66,10 @@ class SynthLoader {
 
   // Any thread: whether the recipe asked for last is waiting or being built (loading from the
   // moment a setter changes it), built, or refused; and (not the audio thread) why it was refused.
-  // "ready" comes after take() can return the build.
+  // "ready" comes after take() can return the build. A refusal leaves the synthesizer playing
+  // before; when none has been built since start(), it leaves a bundled one for take() instead
+  // (the recipe's index first, then the others in order, without file or overrides), which the
+  // error names.
   LoadStatus status() const noexcept { return status_.load(std::memory_order_acquire); }
   std::string error() const;
 
@@ -75,7 +78,8 @@ class SynthLoader {
  private:
   void change(std::string& field, std::string value);  // a string of the recipe, under mutex_
   SynthRecipe wanted() const;
-  void build(const SynthRecipe& recipe);  // into built_, or the status failed
+  void build(const SynthRecipe& recipe);            // into built_, or the status failed
+  std::string standIn(const SynthRecipe& refused);  // a bundled one instead; says which
   void freeGivenBack();
   void run();
 
@@ -89,6 +93,7 @@ class SynthLoader {
   std::string file_, overrides_, error_;
   double sampleRate_ = 48000.0;
   SynthRecipe attempted_;  // the recipe built last, successfully or not
+  bool playable_ = false;  // a synthesizer built since start(): the loader's thread (or start's)
   bool stopping_ = false;
   std::thread thread_;
 };

@@ -1,7 +1,8 @@
 // The plugin's loader: the presets compiled in are presets/'s files; every one builds at the rates
 // hosts run at; overrides are read as --set takes them; a recipe is built at start() and, once
 // running, whenever it changes, away from the caller; a refused one leaves nothing to take and
-// says why; and what the audio thread gives back is taken only when the slot is free.
+// says why (a bundled preset standing in when nothing played before); and what the audio thread
+// gives back is taken only when the slot is free.
 #include "synth_loader.h"
 
 #include <gtest/gtest.h>
@@ -90,6 +91,61 @@ TEST(SynthLoader, StartBuildsNowAndChangesAreBuiltAwayFromTheCaller) {
   EXPECT_EQ(loader.take(), nullptr);  // nothing to take: the one playing plays on
   loader.setOverrides("");            // back to what was built last: its outcome, at once or soon
   EXPECT_EQ(settled(loader), LoadStatus::ready);
+  loader.stop();
+}
+
+// A session restored where its preset file is gone: nothing played before, so the bundled preset
+// the Preset parameter names plays instead of silence, and the error says both.
+TEST(SynthLoader, ARefusedFirstRecipeLeavesABundledPresetToPlay) {
+  SynthLoader loader;
+  loader.setBundled(2);
+  loader.setFile("/nonexistent/session/preset.toml");
+  loader.start(48000.0);
+  EXPECT_EQ(loader.status(), LoadStatus::failed);
+  std::unique_ptr<BuiltSynth> standIn(loader.take());
+  ASSERT_TRUE(standIn);
+  EXPECT_EQ(standIn->recipe, (SynthRecipe{.bundled = 2, .sampleRate = 48000.0}));
+  const std::string error = loader.error();
+  EXPECT_NE(error.find("/nonexistent/session/preset.toml"), std::string::npos) << error;
+  EXPECT_NE(error.find(std::string("playing the bundled \"") + bundledPresets()[2].name),
+            std::string::npos)
+      << error;
+
+  // Once one has been built, a refusal leaves it playing: nothing new to take.
+  loader.setOverrides("bogus.key=1");
+  ASSERT_EQ(settled(loader), LoadStatus::failed);
+  EXPECT_EQ(loader.take(), nullptr);
+  EXPECT_EQ(loader.error().find("playing the bundled"), std::string::npos) << loader.error();
+
+  // A new start() (the host activating again) has nothing playing: it stands in again.
+  loader.stop();
+  loader.start(44100.0);
+  std::unique_ptr<BuiltSynth> again(loader.take());
+  ASSERT_TRUE(again);
+  EXPECT_EQ(again->recipe, (SynthRecipe{.bundled = 2, .sampleRate = 44100.0}));
+  loader.stop();
+}
+
+// At a rate the grand pianos cannot be built at (under 22.05 kHz), the first bundled preset that
+// builds stands in; an index out of range is read as the first.
+TEST(SynthLoader, TheStandInIsTheFirstBundledPresetThatBuildsAtTheRate) {
+  SynthLoader loader;
+  loader.setBundled(99);
+  loader.start(16000.0);
+  EXPECT_EQ(loader.status(), LoadStatus::failed);
+  std::unique_ptr<BuiltSynth> standIn(loader.take());
+  ASSERT_TRUE(standIn);
+  int firstThatBuilds = -1;
+  for (int i = 0; i < static_cast<int>(bundledPresets().size()) && firstThatBuilds < 0; ++i) {
+    try {
+      buildSynth({.bundled = i, .sampleRate = 16000.0});
+      firstThatBuilds = i;
+    } catch (const std::exception&) {
+    }
+  }
+  ASSERT_GT(firstThatBuilds, 0) << "the grand piano builds at 16 kHz: the test needs another rate";
+  EXPECT_EQ(standIn->recipe, (SynthRecipe{.bundled = firstThatBuilds, .sampleRate = 16000.0}));
+  EXPECT_NE(loader.error().find("preset 99"), std::string::npos) << loader.error();
   loader.stop();
 }
 
