@@ -85,4 +85,28 @@ std::string unplayedNotes(std::span<const TimedMessage> messages,
   return outside;
 }
 
+std::string unloadedPrograms(std::span<const TimedMessage> messages, size_t loaded) {
+  std::vector<bool> asked(128, false);
+  for (const TimedMessage& m : messages)
+    if (m.message.kind() == midi::program && m.message.data1 >= loaded)
+      asked[m.message.data1 & 0x7F] = true;
+  std::string programs;
+  for (int p = 0; p < 128; ++p)
+    if (asked[p]) {
+      programs += ' ';
+      programs += std::to_string(p);
+    }
+  return programs;
+}
+
+std::string ignoredProgramText(const std::string& programs, size_t loaded) {
+  const bool several = programs.find(' ', 1) != std::string::npos;
+  const std::string range =
+      loaded == 1 ? "program 0" : "programs 0 to " + std::to_string(loaded - 1);
+  return std::string(several ? "program changes to" : "program change to") + programs +
+         (several ? " are" : " is") + " ignored: " + std::to_string(loaded) +
+         (loaded == 1 ? " preset is" : " presets are") + " loaded (" + range +
+         "); give --preset once per program (the first is program 0)";
+}
+
 }  // namespace hamiltone::cli

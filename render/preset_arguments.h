@@ -33,4 +33,11 @@ std::vector<Instrument> loadPresets(const std::vector<std::string>& files,
 std::string unplayedNotes(std::span<const TimedMessage> messages,
                           const std::vector<Instrument>& instruments);
 
+// The programs `messages` change to that are not loaded (Synth ignores them), as " 3 7", each
+// once, in order (empty when every one is loaded).
+std::string unloadedPrograms(std::span<const TimedMessage> messages, size_t loaded);
+// Why such a change is ignored and what would play it: "program change to 3 is ignored: 1 preset
+// is loaded (program 0); give --preset once per program (the first is program 0)".
+std::string ignoredProgramText(const std::string& programs, size_t loaded);
+
 }  // namespace hamiltone::cli

@@ -116,6 +116,10 @@ int run(const RenderArguments& a) {
                  "hamiltone-render: warning: the preset in force does not play MIDI note(s)%s; "
                  "they are silent\n",
                  outside.c_str());
+  const std::string unloaded = unloadedPrograms(messages, instruments.size());
+  if (!unloaded.empty())
+    std::fprintf(stderr, "hamiltone-render: warning: %s\n",
+                 ignoredProgramText(unloaded, instruments.size()).c_str());
 
   Synth synth;
   try {

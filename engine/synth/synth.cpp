@@ -90,6 +90,8 @@ void Synth::prepare(std::vector<Instrument> instruments, const SynthSetup& setup
   master_ = master;
   maxBlock_ = setup.maxBlock;
   program_ = 0;
+  ignoredPrograms_ = 0;
+  lastIgnoredProgram_ = -1;
   std::fill(std::begin(downProgram_), std::end(downProgram_), -1);
   contact_ = 1.0;
   sostenuto_ = unaCorda_ = false;
@@ -326,7 +328,12 @@ void Synth::handle(const MidiMessage& m) noexcept {
       setBend((((m.data2 & 0x7F) << 7 | (m.data1 & 0x7F)) - 8192) / 8192.0);
       break;
     case midi::program:
-      if (m.data1 < instruments_.size()) program_ = m.data1;
+      if (m.data1 < instruments_.size()) {
+        program_ = m.data1;
+      } else {
+        ++ignoredPrograms_;
+        lastIgnoredProgram_ = m.data1;
+      }
       break;
     default:
       break;

@@ -91,6 +91,10 @@ class Synth {
   // DC-blocker tail at most. (activeVoices() does not count a key fading out.)
   bool silent() const;
   int program() const { return program_; }
+  // Program changes to a program past the last instrument, since prepare(), and the last one's
+  // number (−1 before any): ignored, so that a front end can say so.
+  long ignoredProgramChanges() const { return ignoredPrograms_; }
+  int lastIgnoredProgram() const { return lastIgnoredProgram_; }
   int guardEvents() const;
   long nonFiniteSamples() const { return master_.nonFinite(); }
   // The master's limiter and its meters since prepare(): how often and how deep it acted.
@@ -161,6 +165,8 @@ class Synth {
   MasterBus master_;
   int maxBlock_ = 0;
   int program_ = 0, polyphonyOverride_ = 0;
+  long ignoredPrograms_ = 0;
+  int lastIgnoredProgram_ = -1;
   int downProgram_[128];  // which instrument's voice a held note struck (−1: none)
   bool sostenuto_ = false, unaCorda_ = false;
   double contact_ = 1.0;  // of the dampers of the keys released under the pedal (damperContact)

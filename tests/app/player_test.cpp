@@ -418,6 +418,28 @@ TEST(Player, FinishedOnceTheScoreIsPlayedAndSilent) {
   EXPECT_FALSE(live.status().finished);
 }
 
+// A program change past the last preset, live or scored, is ignored by the synthesizer and
+// counted in the status, with its number, for the main thread to say (it was silent).
+TEST(Player, ProgramChangesPastTheLastPresetAreCountedInTheStatus) {
+  constexpr int kFrames = 256;
+  const TimedMessage score[] = {{0.0, {0xC0, 5, 0}}};
+  Synth synth = prepared({pianoKeys(48, 52)});
+  SpscQueue<StampedMessage> midi(16);
+  Player player(synth, midi, nullptr, kRate, kFrames);
+  EXPECT_EQ(player.status().ignoredPrograms, 0);
+  EXPECT_EQ(player.status().lastIgnoredProgram, -1);
+  player.setScore(score);
+  std::vector<float> interleaved(2 * kFrames);
+  player.render(interleaved.data(), kFrames, kNow);
+  EXPECT_EQ(player.status().ignoredPrograms, 1);
+  EXPECT_EQ(player.status().lastIgnoredProgram, 5);
+  ASSERT_TRUE(midi.push({before(10), {0xC3, 9, 0}}));  // live, on another channel
+  ASSERT_TRUE(midi.push({before(5), {0xC0, 0, 0}}));   // the one preset: taken
+  player.render(interleaved.data(), kFrames, kNow);
+  EXPECT_EQ(player.status().ignoredPrograms, 2);
+  EXPECT_EQ(player.status().lastIgnoredProgram, 9);
+}
+
 // With endRecording (hamiltone-play --midi/--notes, which then exits), the recording ends with the
 // block in which the score finished — its last key faded out — whatever comes after it: the same
 // file in every run at the same block size. It went on until the main thread noticed the end (a

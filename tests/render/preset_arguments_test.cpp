@@ -102,4 +102,22 @@ TEST(PresetArguments, UnplayedNotesFollowTheProgramInForce) {
   EXPECT_EQ(unplayedNotes(std::vector<TimedMessage>{{0.0, {0x90, 72, 90}}}, two), "");
 }
 
+// Program changes past the presets loaded are ignored: the players name them, each once, and say
+// what would play them (they were ignored without a word).
+TEST(PresetArguments, ProgramsNotLoadedAreNamedWithWhatWouldLoadThem) {
+  using hamiltone::TimedMessage;
+  using hamiltone::cli::ignoredProgramText;
+  using hamiltone::cli::unloadedPrograms;
+  const std::vector<TimedMessage> changes = {
+      {0.0, {0xC0, 7, 0}}, {0.1, {0xC1, 1, 0}}, {0.2, {0xC0, 3, 0}}, {0.3, {0xC0, 7, 0}}};
+  EXPECT_EQ(unloadedPrograms(changes, 2), " 3 7");
+  EXPECT_EQ(unloadedPrograms(changes, 8), "");
+  EXPECT_EQ(ignoredProgramText(" 3 7", 2),
+            "program changes to 3 7 are ignored: 2 presets are loaded (programs 0 to 1); give "
+            "--preset once per program (the first is program 0)");
+  EXPECT_EQ(ignoredProgramText(" 5", 1),
+            "program change to 5 is ignored: 1 preset is loaded (program 0); give --preset once "
+            "per program (the first is program 0)");
+}
+
 }  // namespace

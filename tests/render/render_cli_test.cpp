@@ -341,6 +341,24 @@ TEST_F(RenderCli, QuietStillWarnsOfUnplayedNotesAndASilentOutput) {
   EXPECT_NE(r.err.find("the output is silent"), std::string::npos) << r.err;
 }
 
+// A MIDI file that changes to a program no --preset loaded is played on the preset in force, and
+// the render says which programs it ignored and how to load them (it said nothing).
+TEST_F(RenderCli, ProgramChangesToPresetsNotLoadedAreNamed) {
+  using hamiltone::testing::TrackWriter;
+  TrackWriter track;
+  track.event(0, {0xC0, 4}).event(0, {0x90, 60, 80}).event(96, {0x80, 60, 0}).endOfTrack(0);
+  const hamiltone::testing::Bytes file = hamiltone::testing::midiFile(0, 480, {track});
+  const fs::path midi = dir_ / "programs.mid";
+  std::ofstream(midi, std::ios::binary)
+      .write(reinterpret_cast<const char*>(file.data()), static_cast<std::streamsize>(file.size()));
+  const Result r = run("--preset " + preset("small-cymbal") + " --midi " + midi.string() +
+                       " --tail 0.1 --quiet -o " + wav());
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: program change to 4 is ignored: 1 preset is loaded (program 0)"),
+            std::string::npos)
+      << r.err;
+}
+
 // Ogg Vorbis holds rates up to 200 kHz: a higher one is refused before rendering, naming the rate
 // and the formats that hold it (it failed at the first write, exit 1, "Format not recognised").
 TEST_F(RenderCli, OggAboveItsHighestRateIsRefusedBeforeRendering) {
