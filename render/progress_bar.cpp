@@ -27,17 +27,40 @@ std::string formattedEta(double seconds) {
 
 }  // namespace
 
-bool progressWanted(bool quiet) { return !quiet && ::isatty(STDERR_FILENO) == 1; }
+ProgressStyle progressStyle(bool quiet) {
+  if (quiet) return ProgressStyle::none;
+  return ::isatty(STDERR_FILENO) == 1 ? ProgressStyle::line : ProgressStyle::log;
+}
 
-ProgressBar::ProgressBar(double totalSeconds, bool enabled, std::FILE* out)
-    : total_(totalSeconds), enabled_(enabled), out_(out), start_(Clock::now()) {}
+ProgressBar::ProgressBar(double totalSeconds, ProgressStyle style, std::FILE* out,
+                         Clock::duration logInterval)
+    : total_(totalSeconds),
+      style_(style),
+      out_(out),
+      logInterval_(logInterval),
+      start_(Clock::now()),
+      lastDraw_(start_) {}
 
 void ProgressBar::update(double doneSeconds) {
-  if (!enabled_) return;
+  if (style_ == ProgressStyle::none) return;
   const Clock::time_point now = Clock::now();
+  if (style_ == ProgressStyle::log) {
+    if (now - lastDraw_ < logInterval_) return;
+    lastDraw_ = now;
+    std::fprintf(out_, "hamiltone-render: %s\n", text(doneSeconds, now).c_str());
+    std::fflush(out_);
+    return;
+  }
   if (drawnWidth_ > 0 && now - lastDraw_ < kRedrawInterval) return;
   lastDraw_ = now;
+  const std::string line = text(doneSeconds, now);
+  const int width = static_cast<int>(line.size());
+  std::fprintf(out_, "\r%s%*s", line.c_str(), std::max(drawnWidth_ - width, 0), "");
+  std::fflush(out_);
+  drawnWidth_ = width;
+}
 
+std::string ProgressBar::text(double doneSeconds, Clock::time_point now) const {
   const double fraction = total_ > 0.0 ? std::clamp(doneSeconds / total_, 0.0, 1.0) : 1.0;
   const double elapsed = std::chrono::duration<double>(now - start_).count();
   // Nothing done yet: no estimate.
@@ -46,12 +69,9 @@ void ProgressBar::update(double doneSeconds) {
           ? formattedEta(std::max(elapsed * (total_ - doneSeconds) / doneSeconds, 0.0))
           : "--";
   char line[96];
-  const int width =
-      std::snprintf(line, sizeof line, "%4d%%  %.1f s of %.1f s  ETA %s",
-                    static_cast<int>(100.0 * fraction), doneSeconds, total_, eta.c_str());
-  std::fprintf(out_, "\r%s%*s", line, std::max(drawnWidth_ - width, 0), "");
-  std::fflush(out_);
-  drawnWidth_ = width;
+  std::snprintf(line, sizeof line, "%4d%%  %.1f s of %.1f s  ETA %s",
+                static_cast<int>(100.0 * fraction), doneSeconds, total_, eta.c_str());
+  return line;
 }
 
 void ProgressBar::finish() {

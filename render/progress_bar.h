@@ -7,28 +7,38 @@
 
 namespace hamiltone::cli {
 
-// True when stderr is a terminal and --quiet was not given: the case for a ProgressBar.
-bool progressWanted(bool quiet);
+// How the progress is shown: not at all, as a line redrawn in place (a terminal), or as a whole
+// line now and then (a log file or a pipe, where '\r' would pile up).
+enum class ProgressStyle { none, line, log };
+// none under --quiet; else line when stderr is a terminal, log when it is not.
+ProgressStyle progressStyle(bool quiet);
 
 class ProgressBar {
  public:
-  // Draws nothing unless `enabled` (see progressWanted); `out` is stderr but for tests.
-  ProgressBar(double totalSeconds, bool enabled, std::FILE* out = stderr);
+  static constexpr std::chrono::seconds kLogInterval{10};
+  // Draws nothing with ProgressStyle::none; `out` is stderr and `logInterval` kLogInterval but for
+  // tests.
+  ProgressBar(double totalSeconds, ProgressStyle style, std::FILE* out = stderr,
+              std::chrono::steady_clock::duration logInterval = kLogInterval);
   ~ProgressBar() { finish(); }  // an exception that ends the render leaves no half line
   ProgressBar(const ProgressBar&) = delete;
   ProgressBar& operator=(const ProgressBar&) = delete;
 
   // Redraws the line — "  42%  5.3 s of 12.5 s  ETA 0:07" — at most ten times a second, the
-  // first call at once. The ETA assumes the rest renders as fast as what is done so far.
+  // first call at once; or, as a log, writes "hamiltone-render:  42%  5.3 s of 12.5 s  ETA 0:07"
+  // and a new line once each logInterval, the first after one (a short render writes none). The
+  // ETA assumes the rest renders as fast as what is done so far.
   void update(double doneSeconds);
   // Clears the line, so what is printed next starts at the left edge; idempotent.
   void finish();
 
  private:
   using Clock = std::chrono::steady_clock;
+  std::string text(double doneSeconds, Clock::time_point now) const;
   double total_;
-  bool enabled_;
+  ProgressStyle style_;
   std::FILE* out_;
+  Clock::duration logInterval_;
   Clock::time_point start_, lastDraw_;
   int drawnWidth_ = 0;  // characters on the line now, 0 if nothing is drawn
 };

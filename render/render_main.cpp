@@ -133,7 +133,7 @@ int run(const RenderArguments& a) {
 
   WavWriter out(a.out, "-o", static_cast<int>(rate), 2, sampleFormat(a.format), type);
   const double seconds = end + tail;
-  ProgressBar bar(seconds, progressWanted(a.quiet));
+  ProgressBar bar(seconds, progressStyle(a.quiet));
   const RenderStats stats = renderPerformance(synth, messages, seconds, block, rate, out,
                                               [&](double done) { bar.update(done); });
   bar.finish();

@@ -1,5 +1,6 @@
 // ProgressBar, renderSummary and stealSummary: the summaries' wording and arithmetic, a disabled
-// bar that stays silent, and an enabled one that draws one '\r' line, throttled, and clears it.
+// bar that stays silent, an enabled one that draws one '\r' line, throttled, and clears it, and a
+// log's whole lines.
 #include "progress_bar.h"
 
 #include <gtest/gtest.h>
@@ -13,6 +14,7 @@ namespace {
 
 using hamiltone::cli::limiterSummary;
 using hamiltone::cli::ProgressBar;
+using hamiltone::cli::ProgressStyle;
 using hamiltone::cli::renderSummary;
 using hamiltone::cli::stealSummary;
 
@@ -72,7 +74,7 @@ TEST(RenderSummary, LimiterHeadroomOrWhatItDid) {
 TEST(ProgressBar, DisabledWritesNothing) {
   CapturedStream out;
   {
-    ProgressBar bar(10.0, false, out.get());
+    ProgressBar bar(10.0, ProgressStyle::none, out.get());
     bar.update(0.0);
     bar.update(5.0);
     bar.finish();
@@ -82,7 +84,7 @@ TEST(ProgressBar, DisabledWritesNothing) {
 
 TEST(ProgressBar, EnabledDrawsOneLineInPlaceAndClearsIt) {
   CapturedStream out;
-  ProgressBar bar(10.0, true, out.get());
+  ProgressBar bar(10.0, ProgressStyle::line, out.get());
   bar.update(5.0);
   const std::string line = out.text();
   EXPECT_EQ(line.rfind("\r  50%  5.0 s of 10.0 s  ETA ", 0), 0u) << line;
@@ -102,7 +104,7 @@ TEST(ProgressBar, EnabledDrawsOneLineInPlaceAndClearsIt) {
 TEST(ProgressBar, RedrawsAtMostTenTimesASecond) {
   CapturedStream out;
   const auto start = std::chrono::steady_clock::now();
-  ProgressBar bar(10.0, true, out.get());
+  ProgressBar bar(10.0, ProgressStyle::line, out.get());
   for (int i = 1; i <= 100; ++i) bar.update(0.1 * i);
   if (std::chrono::steady_clock::now() - start >= std::chrono::milliseconds(100))
     GTEST_SKIP() << "the machine took 100 ms over 100 updates; a second redraw was allowed";
@@ -110,9 +112,32 @@ TEST(ProgressBar, RedrawsAtMostTenTimesASecond) {
   EXPECT_EQ(std::count(text.begin(), text.end(), '\r'), 1) << text;
 }
 
+// Not on a terminal (a log, a pipe): whole lines, once an interval, none before the first has
+// passed — a render into a log said nothing until its summary, however long it took.
+TEST(ProgressBar, AsALogWritesAWholeLineEachInterval) {
+  CapturedStream out;
+  {
+    ProgressBar bar(10.0, ProgressStyle::log, out.get(), std::chrono::hours(1));
+    bar.update(5.0);
+  }
+  EXPECT_EQ(out.text(), "");  // shorter than the interval: nothing
+  {
+    ProgressBar bar(10.0, ProgressStyle::log, out.get(), std::chrono::steady_clock::duration(0));
+    bar.update(2.5);
+    bar.update(5.0);
+  }
+  const std::string text = out.text();
+  EXPECT_EQ(text.rfind("hamiltone-render:   25%  2.5 s of 10.0 s  ETA ", 0), 0u) << text;
+  EXPECT_NE(text.find("\nhamiltone-render:   50%  5.0 s of 10.0 s  ETA "), std::string::npos)
+      << text;
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 2) << text;
+  EXPECT_EQ(text.find('\r'), std::string::npos) << text;
+  EXPECT_EQ(text.back(), '\n');
+}
+
 TEST(ProgressBar, DestructorClearsTheLine) {
   CapturedStream out;
-  { ProgressBar(10.0, true, out.get()).update(1.0); }
+  { ProgressBar(10.0, ProgressStyle::line, out.get()).update(1.0); }
   const std::string text = out.text();
   ASSERT_FALSE(text.empty());
   EXPECT_EQ(text.back(), '\r');
