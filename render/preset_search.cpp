@@ -44,7 +44,9 @@ std::vector<fs::path> presetDirectories() {
 
 fs::path resolvePreset(const std::string& argument) {
   std::error_code error;
-  if (argument.find('/') != std::string::npos || fs::is_regular_file(argument, error))
+  // A link here, even one that leads nowhere, is the file meant: the loader says what is wrong.
+  if (argument.find('/') != std::string::npos || fs::is_regular_file(argument, error) ||
+      fs::is_symlink(argument, error))
     return argument;
   const std::vector<fs::path> dirs = presetDirectories();
   for (const fs::path& dir : dirs)

@@ -7,9 +7,11 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <optional>
 #include <set>
@@ -807,12 +809,20 @@ std::optional<PresetOverride> parseOverride(std::string_view argument) {
 Instrument loadPreset(const std::filesystem::path& file, const PresetOptions& options) {
   const std::string name = file.string();
   std::error_code error;
-  if (!std::filesystem::exists(file, error))
+  if (!std::filesystem::exists(file, error)) {
+    // ENOENT is no error to exists(); a loop of links or a directory that may not be searched is.
+    if (error) throw PresetError({name + ": cannot read: " + error.message()});
+    std::error_code notLink;
+    if (std::filesystem::is_symlink(file, notLink))
+      throw PresetError({name + ": cannot read: a symbolic link to " +
+                         std::filesystem::read_symlink(file, notLink).string() +
+                         ", which does not exist"});
     throw PresetError({name + ": cannot read: no such file"});
+  }
   if (!std::filesystem::is_regular_file(file, error))
     throw PresetError({name + ": cannot read: not a regular file"});
   std::ifstream in(file, std::ios::binary);
-  if (!in) throw PresetError({name + ": cannot open the file"});
+  if (!in) throw PresetError({name + ": cannot open the file: " + std::strerror(errno)});
   std::string text(kMaxBytes + 1, '\0');
   in.read(text.data(), static_cast<std::streamsize>(text.size()));
   if (in.bad()) throw PresetError({name + ": cannot read the file"});

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <numbers>
@@ -396,6 +397,22 @@ TEST(PresetLoader, RefusesWhatItCannotRead) {
               ElementsAre(HasSubstr("presets: cannot read: not a regular file")));
   EXPECT_THAT(errorsOfText(std::string((1 << 20) + 1, '#')),
               ElementsAre("test.toml: 1048577 bytes: larger than the 1 MiB a preset may be"));
+}
+
+// A link to nothing and a loop of links are said as such (both read "no such file").
+TEST(PresetLoader, SaysWhatIsWrongWithALink) {
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "preset-links";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  std::filesystem::create_symlink(dir / "gone.toml", dir / "dangling.toml");
+  std::filesystem::create_symlink(dir / "b.toml", dir / "a.toml");
+  std::filesystem::create_symlink(dir / "a.toml", dir / "b.toml");
+  EXPECT_THAT(errorsOf((dir / "dangling.toml").string()),
+              ElementsAre(HasSubstr("dangling.toml: cannot read: a symbolic link to " +
+                                    (dir / "gone.toml").string() + ", which does not exist")));
+  EXPECT_THAT(errorsOf((dir / "a.toml").string()),
+              ElementsAre(HasSubstr("a.toml: cannot read: Too many levels of symbolic links")));
+  std::filesystem::remove_all(dir);
 }
 
 // 300 unknown keys: 99 lines and one that counts the rest.
