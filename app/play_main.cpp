@@ -23,6 +23,7 @@
 #include "midi_input.h"
 #include "note_list.h"
 #include "number_arguments.h"
+#include "option_values.h"
 #include "player.h"
 #include "preset_arguments.h"
 #include "recorder.h"
@@ -469,12 +470,16 @@ int runMain(int argc, char** argv) {
       "server or device went away while "
       "playing (the recording is complete up to then).");
   try {
+    hamiltone::cli::refuseOptionsAsValues(app, argc, argv);
     app.parse(argc, argv);
     a.midiGiven = app.count("--midi") > 0;
     a.notesGiven = app.count("--notes") > 0;
   } catch (const CLI::Success& e) {  // --help, --version
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "hamiltone-play: %s (see hamiltone-play --help)\n", e.what());
+    return kExitUsage;
+  } catch (const hamiltone::cli::UsageError& e) {
     std::fprintf(stderr, "hamiltone-play: %s (see hamiltone-play --help)\n", e.what());
     return kExitUsage;
   }

@@ -14,6 +14,7 @@
 #include "midi/midi_file.h"
 #include "note_list.h"
 #include "number_arguments.h"
+#include "option_values.h"
 #include "performance.h"
 #include "preset_arguments.h"
 #include "preset_search.h"
@@ -206,10 +207,14 @@ int runMain(int argc, char** argv) {
       "ignored).");
 
   try {
+    refuseOptionsAsValues(app, argc, argv);
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {  // --help, --version
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "hamiltone-render: %s (see hamiltone-render --help)\n", e.what());
+    return kExitUsage;
+  } catch (const UsageError& e) {
     std::fprintf(stderr, "hamiltone-render: %s (see hamiltone-render --help)\n", e.what());
     return kExitUsage;
   }

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "fpu_command.h"
+#include "option_values.h"
 #include "particle_command.h"
 #include "plate_command.h"
 #include "standard_output.h"
@@ -39,10 +40,14 @@ int runMain(int argc, char** argv) {
   CLI::App* waveCommand = addWaveCommand(app, wave);
 
   try {
+    refuseOptionsAsValues(app, argc, argv);
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {  // --help, --help-all, --version
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "hamiltone-sim: %s (see hamiltone-sim --help)\n", e.what());
+    return kExitUsage;
+  } catch (const UsageError& e) {
     std::fprintf(stderr, "hamiltone-sim: %s (see hamiltone-sim --help)\n", e.what());
     return kExitUsage;
   }

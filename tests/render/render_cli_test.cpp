@@ -359,6 +359,19 @@ TEST_F(RenderCli, ProgramChangesToPresetsNotLoadedAreNamed) {
       << r.err;
 }
 
+// An option whose value was forgotten is refused naming it and the option after it (CLI11 took
+// "--notes" as the preset and then refused the notes: "give exactly one of --midi FILE or --notes
+// LIST").
+TEST_F(RenderCli, AnOptionMissingItsValueIsNamed) {
+  const Result r = run("--preset --notes C4:100:0.1 -o " + wav());
+  EXPECT_EQ(r.exitCode, 2) << r.err;
+  EXPECT_NE(r.err.find("--preset is missing its value: the argument after it, --notes, is an "
+                       "option"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(wav()));
+}
+
 // Ogg Vorbis holds rates up to 200 kHz: a higher one is refused before rendering, naming the rate
 // and the formats that hold it (it failed at the first write, exit 1, "Format not recognised").
 TEST_F(RenderCli, OggAboveItsHighestRateIsRefusedBeforeRendering) {
