@@ -8,9 +8,14 @@ void PlayingSynth::prepare(double sampleRate) {
   release();
   scratchLeft_.assign(kMaxBlock, 0.0f);
   scratchRight_.assign(kMaxBlock, 0.0f);
-  gainSmoothing_ = std::exp(-1.0 / (kGainSmoothingS * sampleRate));
-  swapFade_ = std::max(1L, std::lround(kSwapFadeS * sampleRate));
+  // A rate no synthesizer builds at (a host's NaN) leaves nothing to play: the smoothing stays
+  // finite, so the output is silence rather than NaN.
+  const double rate = std::isfinite(sampleRate) && sampleRate > 0.0 ? sampleRate : 48000.0;
+  gainSmoothing_ = std::exp(-1.0 / (kGainSmoothingS * rate));
+  swapFade_ = std::max(1L, std::lround(kSwapFadeS * rate));
   gain_ = gainTarget_;
+  controlsSet_ = false;
+  std::fill(std::begin(held_), std::end(held_), MidiMessage{});
 }
 
 void PlayingSynth::release() {
@@ -24,9 +29,12 @@ void PlayingSynth::setControls(const Controls& asked) noexcept {
                           .velocityCurve = kVelocityCurveRange.held(asked.velocityCurve),
                           .damperScale = kDamperScaleRange.held(asked.damperScale),
                           .polyphony = static_cast<int>(kPolyphonyRange.held(asked.polyphony))};
-  if (controls == controls_) return;
+  const bool first = !controlsSet_;
+  controlsSet_ = true;
+  if (controls == controls_ && !first) return;
   controls_ = controls;
   gainTarget_ = std::pow(10.0, controls_.gainDb / 20.0);
+  if (first) gain_ = gainTarget_;  // a restored session's gain, not a fade from the last one
   applyControls();
 }
 
@@ -48,6 +56,36 @@ void PlayingSynth::adopt() noexcept {
   }
   current_ = fresh;
   applyControls();
+  // The pedal held down, the volume turned down and the wheel bent stay so across the swap.
+  for (const MidiMessage& m : held_)
+    if (m.status != 0) current_->synth.handle(m);
+}
+
+void PlayingSynth::remember(const MidiMessage& m) noexcept {
+  if (m.kind() == midi::pitchBend) {
+    held_[kBend] = m;
+    return;
+  }
+  if (m.kind() != midi::controller) return;
+  switch (m.data1) {
+    case midi::volume:
+      held_[kVolume] = m;
+      break;
+    case midi::sustainPedal:
+      held_[kSustain] = m;
+      break;
+    case midi::sostenutoPedal:
+      held_[kSostenuto] = m;
+      break;
+    case midi::softPedal:
+      held_[kSoft] = m;
+      break;
+    case midi::resetControllers:  // bend centred, pedals up (Synth::handle); the volume stays
+      held_[kSustain] = held_[kSostenuto] = held_[kSoft] = held_[kBend] = MidiMessage{};
+      break;
+    default:
+      break;
+  }
 }
 
 void PlayingSynth::render(std::span<float> left, std::span<float> right,

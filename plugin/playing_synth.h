@@ -1,7 +1,8 @@
 // What the plugin does on the audio thread, apart from any plugin format: plays the synthesizer
 // the loader built last — swapped in between blocks, the one before faded out (all sound off, its
-// 5 ms fade) and given back to the loader to free — with the player's controls, and MIDI bytes
-// placed on their frames. process() never allocates, locks or does I/O.
+// 5 ms fade) and given back to the loader to free, the new one given the pedals, volume and bend
+// the old one held — with the player's controls, and MIDI bytes placed on their frames. process()
+// never allocates, locks or does I/O.
 #pragma once
 
 #include <algorithm>
@@ -59,7 +60,9 @@ class PlayingSynth {
   PlayingSynth(const PlayingSynth&) = delete;
   PlayingSynth& operator=(const PlayingSynth&) = delete;
 
-  // Not the audio thread, with none running (the plugin's activate): sized for `sampleRate`.
+  // Not the audio thread, with none running (the plugin's activate): sized for `sampleRate`. The
+  // first setControls() after it takes effect at once (a session's gain is not faded in from
+  // 0 dB).
   void prepare(double sampleRate);
   // The same (deactivate): frees the synthesizers this holds.
   void release();
@@ -81,6 +84,7 @@ class PlayingSynth {
   template <class Midi>
   std::optional<MidiMessage> message(const Midi& m) const noexcept;
   void adopt() noexcept HAMILTONE_PLUGIN_NONBLOCKING;
+  void remember(const MidiMessage& m) noexcept HAMILTONE_PLUGIN_NONBLOCKING;
   void applyControls() noexcept HAMILTONE_PLUGIN_NONBLOCKING;
   void render(std::span<float> left, std::span<float> right,
               std::span<const SynthEvent> events) noexcept HAMILTONE_PLUGIN_NONBLOCKING;
@@ -94,6 +98,11 @@ class PlayingSynth {
   long swapFade_ = 1;
   Controls controls_;
   double gain_ = 1.0, gainTarget_ = 1.0, gainSmoothing_ = 0.0;
+  bool controlsSet_ = false;  // since prepare(): until then the gain jumps to its control
+  // The last volume (CC7), sustain, sostenuto and soft pedal and pitch bend played (status 0:
+  // none since prepare(), or reset by CC121), for the next synthesizer adopted.
+  enum Held { kVolume, kSustain, kSostenuto, kSoft, kBend, kHeldCount };
+  MidiMessage held_[kHeldCount] = {};
   SynthEvent events_[kMaxEvents];
   std::vector<float> scratchLeft_, scratchRight_;  // the outgoing synthesizer's output
 };
@@ -124,8 +133,10 @@ void PlayingSynth::process(std::span<float> left, std::span<float> right,
         until = std::max(at, done + 1);
         break;
       }
-      if (const std::optional<MidiMessage> m = message(midi[next]))
+      if (const std::optional<MidiMessage> m = message(midi[next])) {
         events_[count++] = {static_cast<int>(at - done), *m};
+        remember(*m);
+      }
     }
     render(left.subspan(done, until - done), right.subspan(done, until - done),
            std::span<const SynthEvent>(events_, count));

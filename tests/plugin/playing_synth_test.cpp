@@ -104,6 +104,7 @@ TEST_F(PlayingSynthTest, ASwapFadesTheOldSynthesizerOutAndPlaysTheNew) {
 }
 
 TEST_F(PlayingSynthTest, GainFollowsItsControlSmoothly) {
+  playing_.setControls({});  // as the plugin's run() does before every block
   play(playing_, 256, {{0, 3, {0x90, 69, 110}}});
   const float before = play(playing_, 4800).peak();
   playing_.setControls({.gainDb = -60.0});
@@ -112,6 +113,71 @@ TEST_F(PlayingSynthTest, GainFollowsItsControlSmoothly) {
   // own decay); after 90 ms it is at the target's −60 dB (e^−9 = 1.2e−4 of the way left).
   EXPECT_GT(fading.peak(0, 240), 0.5f * before);
   EXPECT_LT(fading.peak(4320), 2e-3f * before);
+}
+
+// A session's gain is the first control a fresh activation is given (in LV2, with the first
+// block): it holds from the first sample, not faded in from 0 dB over 10 ms — a note at the
+// session's start peaked as loud at −60 dB as at 0 dB (hostile test).
+TEST_F(PlayingSynthTest, TheFirstGainAfterPrepareHoldsFromTheFirstSample) {
+  playing_.setControls({.gainDb = -60.0});
+  const float quiet = play(playing_, 4800, {{0, 3, {0x90, 69, 110}}}).peak(0, 480);
+  playing_.release();
+  playing_.prepare(kRate);
+  loader_.start(kRate);
+  playing_.setControls({});
+  const float full = play(playing_, 4800, {{0, 3, {0x90, 69, 110}}}).peak(0, 480);
+  ASSERT_GT(full, 0.01f);
+  EXPECT_LT(quiet, 2e-3f * full);  // −60 dB is 1e-3
+}
+
+// A swap to another synthesizer (a new preset) keeps the pedals, the volume and the bend the
+// player left: with the sustain pedal down and CC7 at 30 before the swap, a key struck and
+// released after it rings on at the volume asked for. (All five were lost: a swap forgot them.)
+TEST_F(PlayingSynthTest, ASwapKeepsThePedalsTheVolumeAndTheBend) {
+  // The reference: the same controllers sent to the new synthesizer itself.
+  loader_.setBundled(6);
+  while (loader_.status() == LoadStatus::loading)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  play(playing_, 4800);  // the swap, and its fade
+  play(playing_, 256, {{0, 3, {0xB0, 64, 127}}, {1, 3, {0xB0, 7, 30}}});
+  play(playing_, 4800);  // the volume's 10 ms smoothing, as after the swap below
+  const std::vector<Midi> strike = {{0, 3, {0x90, 60, 100}}, {2400, 3, {0x80, 60, 0}}};
+  const Block reference = play(playing_, 9600, strike);
+  const float referenceTail = reference.peak(7200);
+
+  // Now the controllers before a swap.
+  playing_.release();
+  loader_.stop();
+  loader_.setBundled(0);
+  loader_.start(kRate);
+  playing_.prepare(kRate);
+  play(playing_, 256, {{0, 3, {0xB0, 64, 127}}, {1, 3, {0xB0, 7, 30}}});
+  loader_.setBundled(6);
+  while (loader_.status() == LoadStatus::loading)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  play(playing_, 4800);
+  const Block swapped = play(playing_, 9600, strike);
+  ASSERT_GT(referenceTail, 1e-4f);  // the pedal holds the released key
+  // The volume: (30/127)² of the peak at full volume, where the swap once played it.
+  EXPECT_NEAR(swapped.peak(), reference.peak(), 0.02f * reference.peak());
+  EXPECT_NEAR(swapped.peak(7200), referenceTail, 0.02f * referenceTail);
+}
+
+// A host's sample rate of NaN or ±inf builds no synthesizer; the output is silence, not NaN (it
+// was NaN for good: the gain's smoothing took the rate).
+TEST(PlayingSynth, ARateNoSynthesizerBuildsAtGivesSilence) {
+  for (const double rate : {std::numeric_limits<double>::quiet_NaN(),
+                            std::numeric_limits<double>::infinity(), -48000.0}) {
+    SynthLoader loader;
+    loader.start(rate);
+    EXPECT_EQ(loader.status(), LoadStatus::failed) << rate;
+    PlayingSynth playing(loader);
+    playing.prepare(rate);
+    playing.setControls({});
+    const Block b = play(playing, 256, {{0, 3, {0x90, 60, 100}}});
+    for (const float x : b.left) ASSERT_EQ(x, 0.0f) << rate;
+    loader.stop();
+  }
 }
 
 // A host may send any float: a gain of +1000 dB made the output infinite and, once the smoothing
