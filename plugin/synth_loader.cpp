@@ -14,6 +14,7 @@
 
 #include "bundled_presets.h"
 #include "presets/preset_loader.h"
+#include "util/format_number.h"
 
 namespace hamiltone::plugin {
 
@@ -103,50 +104,87 @@ SynthRecipe SynthLoader::wanted() const {
 void SynthLoader::build(const SynthRecipe& recipe) {
   status_.store(LoadStatus::loading, std::memory_order_release);
   try {
-    std::unique_ptr<BuiltSynth> built = buildSynth(recipe);
-    // One the audio thread has not taken yet is superseded: it can no longer take it.
-    delete built_.exchange(built.release(), std::memory_order_acq_rel);
+    publish(buildSynth(recipe));
     {
       const std::lock_guard lock(mutex_);
       error_.clear();
     }
     outcome_.store(LoadStatus::ready, std::memory_order_release);
-    status_.store(LoadStatus::ready, std::memory_order_release);
-    playable_ = true;
+    settle(recipe, LoadStatus::ready);
   } catch (const std::exception& e) {
-    // Hosts keep a plugin's stderr in their log. The synthesizer playing before plays on; with
-    // none (a session restored on a machine without its preset file), a bundled one stands in.
+    // Hosts keep a plugin's stderr in their log. The synthesizer playing before plays on — but
+    // when none plays yet, for a preset file this machine cannot read (a session moved here
+    // without it), or when the Preset knob chose another bundled preset the overrides do not
+    // fit: then the bundled preset the knob names stands in (hosts without a UI for the plugin's
+    // strings leave the knob the only way out).
     std::string why = e.what();
-    if (!playable_) why += standIn(recipe);
+    const bool otherBundled =
+        recipe.file.empty() && playing_ && playing_->bundled != recipe.bundled;
+    if (!playing_ || otherBundled || fileUnreadable(recipe)) why += standIn(recipe);
     {
       const std::lock_guard lock(mutex_);
       error_ = why;
     }
     outcome_.store(LoadStatus::failed, std::memory_order_release);
-    status_.store(LoadStatus::failed, std::memory_order_release);
+    settle(recipe, LoadStatus::failed);
     std::fprintf(stderr, "hamiltone plugin: %s\n", why.c_str());
   }
 }
 
-// The bundled preset the recipe's index names (the first, if it names none), then the others in
-// their order, each without file or overrides: the first that builds is left for take().
+// One the audio thread has not taken yet is superseded: it can no longer take it.
+void SynthLoader::publish(std::unique_ptr<BuiltSynth> built) {
+  playing_ = built->recipe;
+  delete built_.exchange(built.release(), std::memory_order_acq_rel);
+}
+
+// The outcome becomes the status only while `recipe` is still the one asked for: one asked for
+// since (a knob moved during the build) is loading until it is built in turn.
+void SynthLoader::settle(const SynthRecipe& recipe, LoadStatus outcome) {
+  const std::lock_guard lock(mutex_);
+  if (wanted() == recipe)
+    status_.store(outcome, std::memory_order_release);
+  else
+    status_.store(LoadStatus::loading, std::memory_order_release);
+}
+
+bool SynthLoader::fileUnreadable(const SynthRecipe& recipe) {
+  if (recipe.file.empty()) return false;
+  try {
+    loadPreset(recipe.file, {.checkVoices = false});
+    return false;
+  } catch (const std::exception&) {
+    return true;
+  }
+}
+
+// The bundled preset the recipe's index names (the first, if it names none) with the recipe's
+// overrides, then without them, then the other bundled presets in their order: the first that
+// builds at the rate is left for take().
 std::string SynthLoader::standIn(const SynthRecipe& refused) {
   const auto presets = bundledPresets();
   const int count = static_cast<int>(presets.size());
   const int first = refused.bundled >= 0 && refused.bundled < count ? refused.bundled : 0;
-  for (int i = 0; i < count; ++i) {
-    const SynthRecipe candidate{.bundled = (first + i) % count, .sampleRate = refused.sampleRate};
+  std::vector<SynthRecipe> candidates;
+  if (!refused.overrides.empty())
+    candidates.push_back(
+        {.bundled = first, .overrides = refused.overrides, .sampleRate = refused.sampleRate});
+  for (int i = 0; i < count; ++i)
+    candidates.push_back({.bundled = (first + i) % count, .sampleRate = refused.sampleRate});
+  for (const SynthRecipe& candidate : candidates) {
     if (candidate == refused) continue;  // refused already
+    const std::string playing = std::string("; playing the bundled \"") +
+                                presets[candidate.bundled].name + "\"" +
+                                (candidate.overrides.empty() ? "" : " with the overrides") +
+                                " until a preset that builds is chosen";
+    if (playing_ == candidate) return playing;  // standing in already: not built again
     try {
-      delete built_.exchange(buildSynth(candidate).release(), std::memory_order_acq_rel);
-      playable_ = true;
-      return std::string("; playing the bundled \"") + presets[candidate.bundled].name +
-             "\" until a preset that builds is chosen";
+      publish(buildSynth(candidate));
+      return playing;
     } catch (const std::exception&) {
       continue;  // the next (at this rate some presets cannot be built)
     }
   }
-  return "; no bundled preset builds at " + std::to_string(std::lround(refused.sampleRate)) +
+  return "; no bundled preset builds at " + formatNumber(refused.sampleRate) +
          " Hz either: silent until one that does is chosen";
 }
 
@@ -159,10 +197,11 @@ void SynthLoader::start(double sampleRate) {
   SynthRecipe recipe;
   {
     const std::lock_guard lock(mutex_);
-    sampleRate_ = sampleRate;
+    // NaN would make every recipe differ from itself, and the thread build it again each poll.
+    sampleRate_ = std::isfinite(sampleRate) ? sampleRate : 0.0;
     stopping_ = false;
     recipe = attempted_ = wanted();
-    playable_ = false;  // deactivate freed what played
+    playing_.reset();  // deactivate freed what played
   }
   build(recipe);
   thread_ = std::thread(&SynthLoader::run, this);
@@ -192,6 +231,15 @@ void SynthLoader::run() {
     if (recipe == attempted_) {  // unchanged, or changed and changed back
       previous = recipe;
       status_.store(outcome_.load(std::memory_order_acquire), std::memory_order_release);
+      continue;
+    }
+    // The Preset knob moved while a preset file plays, which wins over it: nothing to build (a
+    // swap would cut every note for the same instrument).
+    if (playing_ && !playing_->file.empty() && playing_->file == recipe.file &&
+        playing_->overrides == recipe.overrides && playing_->sampleRate == recipe.sampleRate) {
+      attempted_ = previous = recipe;
+      outcome_.store(LoadStatus::ready, std::memory_order_release);
+      status_.store(LoadStatus::ready, std::memory_order_release);
       continue;
     }
     status_.store(LoadStatus::loading, std::memory_order_release);

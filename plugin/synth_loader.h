@@ -9,6 +9,7 @@
 #include <condition_variable>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -66,10 +67,13 @@ class SynthLoader {
 
   // Any thread: whether the recipe asked for last is waiting or being built (loading from the
   // moment a setter changes it), built, or refused; and (not the audio thread) why it was refused.
-  // "ready" comes after take() can return the build. A refusal leaves the synthesizer playing
-  // before; when none has been built since start(), it leaves a bundled one for take() instead
-  // (the recipe's index first, then the others in order, without file or overrides), which the
-  // error names.
+  // "ready" comes after take() can return the build, and only while its recipe is still the one
+  // asked for. A refusal leaves the synthesizer playing before; when none has been built since
+  // start(), when the recipe's preset file cannot be read or parsed, or when (with no file) the
+  // bundled index changed to one the overrides do not fit, it leaves a bundled one for take()
+  // instead (the recipe's index first, with its overrides and then without, then the others in
+  // order, each without the file), which the error names. While a preset file plays, a change of
+  // the bundled index alone builds nothing.
   LoadStatus status() const noexcept { return status_.load(std::memory_order_acquire); }
   std::string error() const;
 
@@ -79,7 +83,10 @@ class SynthLoader {
   void change(std::string& field, std::string value);  // a string of the recipe, under mutex_
   SynthRecipe wanted() const;
   void build(const SynthRecipe& recipe);            // into built_, or the status failed
-  std::string standIn(const SynthRecipe& refused);  // a bundled one instead; says which
+  void publish(std::unique_ptr<BuiltSynth> built);  // into built_, as playing_
+  void settle(const SynthRecipe& recipe, LoadStatus outcome);
+  static bool fileUnreadable(const SynthRecipe& recipe);  // its file, alone, cannot be loaded
+  std::string standIn(const SynthRecipe& refused);        // a bundled one instead; says which
   void freeGivenBack();
   void run();
 
@@ -93,7 +100,9 @@ class SynthLoader {
   std::string file_, overrides_, error_;
   double sampleRate_ = 48000.0;
   SynthRecipe attempted_;  // the recipe built last, successfully or not
-  bool playable_ = false;  // a synthesizer built since start(): the loader's thread (or start's)
+  // The recipe of the synthesizer built last since start(), if any: the loader's thread's (or
+  // start's).
+  std::optional<SynthRecipe> playing_;
   bool stopping_ = false;
   std::thread thread_;
 };

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -111,18 +112,30 @@ TEST(SynthLoader, ARefusedFirstRecipeLeavesABundledPresetToPlay) {
             std::string::npos)
       << error;
 
-  // Once one has been built, a refusal leaves it playing: nothing new to take.
+  // The file still unreadable, overrides that do not parse: the same stand-in, not built again
+  // (a swap would cut its notes).
   loader.setOverrides("bogus.key=1");
   ASSERT_EQ(settled(loader), LoadStatus::failed);
   EXPECT_EQ(loader.take(), nullptr);
-  EXPECT_EQ(loader.error().find("playing the bundled"), std::string::npos) << loader.error();
+  EXPECT_NE(loader.error().find("/nonexistent/session/preset.toml"), std::string::npos)
+      << loader.error();
+  EXPECT_NE(loader.error().find(std::string("playing the bundled \"") + bundledPresets()[2].name),
+            std::string::npos)
+      << loader.error();
+  // The Preset knob is the way out in a host that shows no strings: it chooses the stand-in.
+  loader.setBundled(4);
+  ASSERT_EQ(settled(loader), LoadStatus::failed);
+  std::unique_ptr<BuiltSynth> chosen(loader.take());
+  ASSERT_TRUE(chosen);
+  EXPECT_EQ(chosen->recipe, (SynthRecipe{.bundled = 4, .sampleRate = 48000.0}));
 
   // A new start() (the host activating again) has nothing playing: it stands in again.
   loader.stop();
+  loader.setOverrides("");
   loader.start(44100.0);
   std::unique_ptr<BuiltSynth> again(loader.take());
   ASSERT_TRUE(again);
-  EXPECT_EQ(again->recipe, (SynthRecipe{.bundled = 2, .sampleRate = 44100.0}));
+  EXPECT_EQ(again->recipe, (SynthRecipe{.bundled = 4, .sampleRate = 44100.0}));
   loader.stop();
 }
 
@@ -147,6 +160,31 @@ TEST(SynthLoader, TheStandInIsTheFirstBundledPresetThatBuildsAtTheRate) {
   EXPECT_EQ(standIn->recipe, (SynthRecipe{.bundled = firstThatBuilds, .sampleRate = 16000.0}));
   EXPECT_NE(loader.error().find("preset 99"), std::string::npos) << loader.error();
   loader.stop();
+}
+
+// While a preset file plays, it wins over the Preset knob: moving the knob builds nothing (it
+// rebuilt the same file and swapped it in, cutting every note).
+TEST(SynthLoader, ThePresetKnobBuildsNothingWhileAFilePlays) {
+  const std::string file = ::testing::TempDir() + "loader-gong.toml";
+  std::ofstream(file) << slurp(std::string(HAMILTONE_SOURCE_DIR) + "/presets/gong.toml");
+  SynthLoader loader;
+  loader.setFile(file);
+  loader.start(48000.0);
+  ASSERT_EQ(loader.status(), LoadStatus::ready) << loader.error();
+  std::unique_ptr<BuiltSynth> built(loader.take());
+  ASSERT_TRUE(built);
+  EXPECT_EQ(built->recipe.file, file);
+  loader.setBundled(5);
+  EXPECT_EQ(settled(loader), LoadStatus::ready);
+  std::this_thread::sleep_for(std::chrono::milliseconds(5 * SynthLoader::kPollMs));
+  EXPECT_EQ(loader.take(), nullptr);
+  loader.setFile("");  // the file cleared: the knob's preset is built
+  ASSERT_EQ(settled(loader), LoadStatus::ready);
+  std::unique_ptr<BuiltSynth> knob(loader.take());
+  ASSERT_TRUE(knob);
+  EXPECT_EQ(knob->recipe, (SynthRecipe{.bundled = 5, .sampleRate = 48000.0}));
+  loader.stop();
+  std::remove(file.c_str());
 }
 
 TEST(SynthLoader, WhatIsGivenBackWaitsForTheSlotAndIsFreedByTheLoader) {
