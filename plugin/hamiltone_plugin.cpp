@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <cmath>
+#include <cstdlib>
 #include <span>
 #include <vector>
 
@@ -63,7 +64,12 @@ class HamiltonePlugin : public Plugin {
     state.key = kStateKeys[index];
     state.defaultValue = "";
     state.hints = kStateIsOnlyForDSP;
-    if (index == kPresetFile) {
+    if (index == kPresetIndex) {
+      state.label = "Preset index";
+      state.description =
+          "The Preset parameter, saved again so that it is restored before the "
+          "first block; empty: the parameter alone.";
+    } else if (index == kPresetFile) {
       state.hints |= kStateIsFilenamePath;
       state.label = "Preset file";
       state.description =
@@ -97,10 +103,26 @@ class HamiltonePlugin : public Plugin {
 
   // Not the audio thread (DPF calls it from the host's main or worker thread).
   void setState(const char* key, const char* value) override {
-    if (String(key) == kStateKeys[kPresetFile])
+    if (String(key) == kStateKeys[kPresetFile]) {
       loader_.setFile(value);
-    else if (String(key) == kStateKeys[kOverrides])
+    } else if (String(key) == kStateKeys[kOverrides]) {
       loader_.setOverrides(value);
+    } else if (String(key) == kStateKeys[kPresetIndex]) {
+      // A whole number, or nothing (a session saved before the key existed): the parameter's.
+      char* end = nullptr;
+      const long index = std::strtol(value, &end, 10);
+      if (end == value || *end != '\0' || index < 0 || index > 127) return;
+      setParameterValue(kPreset, static_cast<float>(index));
+    }
+  }
+
+  // Not the audio thread: what the session saves (DISTRHO_PLUGIN_WANT_FULL_STATE).
+  String getState(const char* key) const override {
+    if (String(key) == kStateKeys[kPresetFile]) return String(loader_.file().c_str());
+    if (String(key) == kStateKeys[kOverrides]) return String(loader_.overrides().c_str());
+    if (String(key) == kStateKeys[kPresetIndex])
+      return String(static_cast<int>(std::lround(values_[kPreset].load())));
+    return String();
   }
 
   void activate() override {

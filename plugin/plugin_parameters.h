@@ -17,8 +17,10 @@ enum Parameter : unsigned {
 // The values of kStatus.
 enum class LoadStatus { loading = 0, ready = 1, failed = 2 };
 
-// State: host-writable strings, saved and restored with the session.
-enum StateKey : unsigned { kPresetFile, kOverrides, kStateCount };
-inline constexpr const char* kStateKeys[kStateCount] = {"preset_file", "overrides"};
+// State, saved and restored with the session: two host-writable strings, and the Preset
+// parameter's value again — an LV2 host restores state before the plugin plays, but its control
+// ports only with the first block, so that the first build was always the default preset.
+enum StateKey : unsigned { kPresetFile, kOverrides, kPresetIndex, kStateCount };
+inline constexpr const char* kStateKeys[kStateCount] = {"preset_file", "overrides", "preset_index"};
 
 }  // namespace hamiltone::plugin

@@ -89,6 +89,16 @@ bool SynthLoader::giveBack(BuiltSynth* done) noexcept {
   return givenBack_.compare_exchange_strong(empty, done, std::memory_order_acq_rel);
 }
 
+std::string SynthLoader::file() const {
+  const std::lock_guard lock(mutex_);
+  return file_;
+}
+
+std::string SynthLoader::overrides() const {
+  const std::lock_guard lock(mutex_);
+  return overrides_;
+}
+
 std::string SynthLoader::error() const {
   const std::lock_guard lock(mutex_);
   return error_;

@@ -51,6 +51,9 @@ class SynthLoader {
   // Not the audio thread: the preset file and the overrides (the plugin's state); wake the thread.
   void setFile(std::string file);
   void setOverrides(std::string overrides);
+  // Not the audio thread: the strings as set (what the session saves).
+  std::string file() const;
+  std::string overrides() const;
 
   // Not the audio thread, with no audio thread running (the plugin's activate): builds the recipe
   // at `sampleRate` here and now, leaves it for take(), then starts the thread that follows the

@@ -16,6 +16,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <optional>
 #include <span>
 #include <string>
@@ -199,6 +200,51 @@ TEST_F(JalvPlugin, PlaysAScoreFromJackMidiInTuneAtTheServersRate) {
   }
   GTEST_SKIP() << "the JACK server logged xruns in all " << kAttempts
                << " runs (a busy host): onset timing was not judged";
+}
+
+// A session whose preset file is gone on this machine, saved with Preset = 3 (the gong): jalv
+// restores the state before the plugin plays, and the stand-in it builds at activation is the
+// gong the session names. Before the Preset was saved in the state too (preset_index), it was
+// the grand piano: the control port reaches an LV2 plugin only with the first block.
+TEST_F(JalvPlugin, ASessionsStateChoosesThePresetBeforeTheFirstBlock) {
+  if (!missing_.empty()) {
+    if (std::getenv("CI") && std::string(std::getenv("CI")) == "true")
+      FAIL() << "missing in CI: " << missing_ << " (scripts/install-deps.sh installs them)";
+    GTEST_SKIP() << "not installed: " << missing_;
+  }
+  const fs::path session = dir_ / "session";
+  fs::create_directories(session);
+  std::ofstream(session / "manifest.ttl")
+      << "@prefix lv2: <http://lv2plug.in/ns/lv2core#> .\n"
+         "@prefix pset: <http://lv2plug.in/ns/ext/presets#> .\n"
+         "@prefix rdfs: <http://www.w3.org/2000/01/rdf-schema#> .\n"
+         "<state.ttl> a pset:Preset ; lv2:appliesTo <urn:hamiltone:hamiltone> ;"
+         " rdfs:seeAlso <state.ttl> .\n";
+  std::ofstream(session / "state.ttl")
+      << "@prefix atom: <http://lv2plug.in/ns/ext/atom#> .\n"
+         "@prefix lv2: <http://lv2plug.in/ns/lv2core#> .\n"
+         "@prefix pset: <http://lv2plug.in/ns/ext/presets#> .\n"
+         "@prefix state: <http://lv2plug.in/ns/ext/state#> .\n"
+         "<> a pset:Preset ; lv2:appliesTo <urn:hamiltone:hamiltone> ;\n"
+         "  lv2:port [ lv2:symbol \"preset\" ; pset:value 3.0 ] ;\n"
+         "  state:state [\n"
+         "    <urn:hamiltone:hamiltone#preset_file> \"/nonexistent/gong.toml\"^^atom:Path ;\n"
+         "    <urn:distrho:preset_index> \"3\"\n"
+         "  ] .\n";
+  useServer(server_);
+  spawn(jackd_,
+        {"jackd", "-n", server_, "--no-realtime", "-d", "dummy", "-r", "44100", "-p", "256"},
+        "jackd");
+  ASSERT_NO_FATAL_FAILURE(awaitPort("system:playback_1", jackd_, 15.0));
+  spawn(jalv_, {"jalv", "-n", kClient, "-l", session.string(), "urn:hamiltone:hamiltone"}, "jalv",
+        Child::Stdin::pipe);
+  ASSERT_NO_FATAL_FAILURE(awaitPort(std::string(kClient) + ":lv2_events_in", jalv_, 60.0));
+  jalv_->closeStdin();
+  EXPECT_EQ(jalv_->wait(10.0), 0) << slurp(dir_ / "jalv.err");
+  const std::string log = slurp(dir_ / "jalv.err") + slurp(dir_ / "jalv.out");
+  EXPECT_NE(log.find("/nonexistent/gong.toml: cannot read"), std::string::npos) << log;
+  EXPECT_NE(log.find("playing the bundled \"Gong\""), std::string::npos) << log;
+  EXPECT_EQ(log.find("Grand piano"), std::string::npos) << log;
 }
 
 }  // namespace

@@ -241,6 +241,26 @@ TEST(ClapPlugin, StateRoundTripsParametersPresetFileAndOverrides) {
             std::string::npos);
 }
 
+// The Preset parameter is saved in the state too ("preset_index"), which hosts restore before the
+// first block — an LV2 host's control ports come only with it, so the first build was the grand
+// piano and the session's instrument replaced it a few blocks in, cutting the notes begun there.
+// A session of the paper's string (F#2 … F#3) plays no A4 from its very first block.
+TEST(ClapPlugin, TheSessionsPresetPlaysFromTheFirstBlock) {
+  ClapInstance first(library(), kId);
+  ASSERT_TRUE(first.activate(48000.0, 1, 512));
+  play(first, 48000.0, 0.01, {param(0, kPreset, 1.0)}, {64});
+  ASSERT_EQ(settle(first, kStatus, double(LoadStatus::loading)), double(LoadStatus::ready));
+  const std::string saved = first.saveState();
+  EXPECT_NE(saved.find(std::string("preset_index") + '\0' + "1" + '\0'), std::string::npos);
+
+  ClapInstance second(library(), kId);
+  ASSERT_TRUE(second.loadState(saved));
+  ASSERT_TRUE(second.activate(48000.0, 1, 512));
+  EXPECT_EQ(second.param(kPreset), 1.0);
+  const Take take = play(second, 48000.0, 0.5, {noteOn(0.0, kA4)}, {256});
+  EXPECT_LT(take.peak(0.0, 0.5), 1e-6) << "A4 sounds: the grand piano played the first blocks";
+}
+
 // The preset parameter changed while processing: the new instrument is built away from the audio
 // thread and swapped in; the paper's string (F#2 … F#3) has no A4 but plays C3, harmonically.
 TEST(ClapPlugin, ChangesPresetWhilePlaying) {
