@@ -31,7 +31,12 @@ std::vector<PresetOverride> overridesOf(const std::string& text) {
     const size_t first = piece.find_first_not_of(" \t\r");
     if (first == std::string::npos || piece[first] == '#') continue;
     std::optional<PresetOverride> o = parseOverride(piece);
-    if (!o) throw std::invalid_argument("overrides: \"" + piece + "\": expected NAME=VALUE");
+    if (!o) {
+      // A host's log takes one line: a megabyte of junk is named by its start.
+      constexpr size_t kShown = 60;
+      const std::string shown = piece.size() > kShown ? piece.substr(0, kShown) + "…" : piece;
+      throw std::invalid_argument("overrides: \"" + shown + "\": expected NAME=VALUE");
+    }
     overrides.push_back(std::move(*o));
   }
   return overrides;
@@ -41,7 +46,9 @@ std::vector<PresetOverride> overridesOf(const std::string& text) {
 
 std::unique_ptr<BuiltSynth> buildSynth(const SynthRecipe& recipe) {
   // The voices are checked by Synth::prepare at the host's rate, which is the check that counts.
-  const PresetOptions options{.checkVoices = false, .overrides = overridesOf(recipe.overrides)};
+  const PresetOptions options{.checkVoices = false,
+                              .overrides = overridesOf(recipe.overrides),
+                              .overrideLabel = "overrides: "};
   std::vector<Instrument> instruments;
   if (!recipe.file.empty()) {
     instruments.push_back(loadPreset(recipe.file, options));

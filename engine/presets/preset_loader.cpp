@@ -305,7 +305,7 @@ class Loader {
   void readSection(std::string_view section, const toml::table& table, Place at);
   void readAnchors(const toml::node& node, Place at);
   void readAnchor(const toml::table& table, size_t ordinal);
-  void readOverrides(const std::vector<PresetOverride>& overrides);
+  void readOverrides(const std::vector<PresetOverride>& overrides, const std::string& label);
   std::string said(const std::string& name, const std::string& shown, Place at) const;
   void entry(std::string name, const toml::node& value, Place at, Settings& into,
              const std::string& label);
@@ -379,7 +379,7 @@ Instrument Loader::load(std::string_view text, const PresetOptions& options) {
   readModel(root);
   readRoot(root);
   checkAnchors();  // the file's own: a narrower range from --set keeps the anchors beyond it
-  readOverrides(options.overrides);
+  readOverrides(options.overrides, options.overrideLabel);
   checkRequired();
   checkBounds();
   throwIfErrors();
@@ -489,9 +489,9 @@ void Loader::readAnchor(const toml::table& table, size_t ordinal) {
 
 // Each --set after the file, as a key of the file: a valid one replaces the file's value, and a
 // per-key one the anchors' values too, so that it holds at every key.
-void Loader::readOverrides(const std::vector<PresetOverride>& overrides) {
+void Loader::readOverrides(const std::vector<PresetOverride>& overrides, const std::string& label) {
   for (const PresetOverride& o : overrides) {
-    overrides_.push_back("--set " + clip(o.name, false) + "=" + clip(o.value, false));
+    overrides_.push_back(label + clip(o.name, false) + "=" + clip(o.value, false));
     const Place at{.set = static_cast<int>(overrides_.size())};
     if (o.name == "model") {
       error(at, overrides_.back() +

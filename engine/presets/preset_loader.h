@@ -55,6 +55,9 @@ struct PresetOptions {
   // cannot be set: it decides what every other key of the file means. A voice refused with the
   // overrides is reported at the setting it names, with every --set listed after it.
   std::vector<PresetOverride> overrides = {};
+  // How the messages name an override, before its NAME=VALUE: the command lines' "--set ", the
+  // plugin's "overrides: ".
+  std::string overrideLabel = "--set ";
 };
 
 // Reads `file` (at most 1 MiB) and parses it; its path, as given, names it in the messages.

@@ -64,6 +64,20 @@ TEST(BuildSynth, OverridesAreReadAsSetTakesThemAndBadOnesSayWhy) {
     EXPECT_STREQ(e.what(), "overrides: \"a4_Hz\": expected NAME=VALUE");
   }
   EXPECT_THROW(buildSynth({.overrides = "a4_Hz=1000"}), std::exception);
+  // The plugin's messages name its overrides, not hamiltone-render's --set, and a long piece of
+  // junk by its start (a 1 MB one went whole into the host's log line).
+  try {
+    buildSynth({.overrides = "a4_Hz=1000"});
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("overrides: a4_Hz=1000"), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()).find("--set"), std::string::npos) << e.what();
+  }
+  try {
+    buildSynth({.overrides = std::string(1 << 20, 'x')});
+    FAIL() << "accepted";
+  } catch (const std::exception& e) {
+    EXPECT_LT(std::string(e.what()).size(), 120u);
+  }
   EXPECT_THROW(buildSynth({.bundled = 7}), std::invalid_argument);
   EXPECT_THROW(buildSynth({.file = "/nonexistent/preset.toml"}), std::exception);
 }
