@@ -120,8 +120,12 @@ class HamiltonePlugin : public Plugin {
   String getState(const char* key) const override {
     if (String(key) == kStateKeys[kPresetFile]) return String(loader_.file().c_str());
     if (String(key) == kStateKeys[kOverrides]) return String(loader_.overrides().c_str());
-    if (String(key) == kStateKeys[kPresetIndex])
-      return String(static_cast<int>(std::lround(values_[kPreset].load())));
+    if (String(key) == kStateKeys[kPresetIndex]) {
+      const float index = values_[kPreset].load();  // a host's NaN or inf: the parameter alone
+      return std::isfinite(index) && std::abs(index) < 1e9f
+                 ? String(static_cast<int>(std::lround(index)))
+                 : String();
+    }
     return String();
   }
 
