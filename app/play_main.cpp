@@ -9,6 +9,7 @@
 #include <CLI/Validators.hpp>
 #include <algorithm>
 #include <csignal>
+#include <cstdint>
 #include <cstdio>
 #include <ctime>
 #include <memory>
@@ -282,7 +283,8 @@ int play(const PlayArguments& a) {
     return t;
   }();
   timespec wait{0, 250'000'000};
-  int signal = -1, polls = 0, ignoredShown = -1;
+  int signal = -1, polls = 0;
+  std::uint64_t ignoredShown[2] = {};  // the ignored programs said so far
   bool recordingFailureShown = false, lost = false, scheduled = false, finished = false,
        portGone = false;
   while (signal < 0) {
@@ -314,14 +316,19 @@ int play(const PlayArguments& a) {
         s, double(now.tv_sec - started.tv_sec) + 1e-9 * double(now.tv_nsec - started.tv_nsec));
     if (!limitLine.empty())
       std::fprintf(stderr, "%shamiltone-play: %s\n", status ? "\n" : "", limitLine.c_str());
-    // A program change past the last preset (live or in the score): said once a program.
-    if (s.ignoredPrograms > 0 && s.lastIgnoredProgram != ignoredShown) {
-      ignoredShown = s.lastIgnoredProgram;
-      std::fprintf(
-          stderr, "%shamiltone-play: warning: %s\n", status ? "\n" : "",
-          cli::ignoredProgramText(" " + std::to_string(ignoredShown), synth.instruments().size())
-              .c_str());
+    // Program changes past the last preset (live or in the score): each program said once.
+    std::string programs;
+    for (int p = 0; p < 128; ++p) {
+      const std::uint64_t bit = std::uint64_t{1} << (p % 64);
+      if ((s.ignoredPrograms[p / 64] & bit) && !(ignoredShown[p / 64] & bit)) {
+        ignoredShown[p / 64] |= bit;
+        programs += ' ';
+        programs += std::to_string(p);
+      }
     }
+    if (!programs.empty())
+      std::fprintf(stderr, "%shamiltone-play: warning: %s\n", status ? "\n" : "",
+                   cli::ignoredProgramText(programs, synth.instruments().size()).c_str());
     // The keyboard's port, once a second: unplugged, or its program gone; back, or (on JACK)
     // gone and back between two checks, its connection gone with its old port.
     if (++polls % 4 == 0 && !midi.portName().empty()) {

@@ -112,8 +112,8 @@ void Player::render(float* interleaved, int frames, std::int64_t nowNs) noexcept
   const int voices = synth_.activeVoices();
   voices_.store(voices, std::memory_order_relaxed);
   guard_.store(synth_.guardEvents(), std::memory_order_relaxed);
-  lastIgnoredProgram_.store(synth_.lastIgnoredProgram(), std::memory_order_relaxed);
-  ignoredPrograms_.store(synth_.ignoredProgramChanges(), std::memory_order_relaxed);
+  for (int w = 0; w < 2; ++w)
+    ignoredPrograms_[w].store(synth_.ignoredPrograms(w), std::memory_order_relaxed);
   limitedFrames_.store(synth_.limiter().limitedFrames(), std::memory_order_relaxed);
   limiterDeepestDb_.store(synth_.limiter().deepestReductionDb(), std::memory_order_relaxed);
   if (hasScore_ && nextScored_ == score_.size() && voices == 0 && synth_.silent()) {
@@ -174,8 +174,7 @@ Player::Status Player::status() const {
   s.voices = voices_.load();
   s.limit = limitShown_.load();
   s.guardEvents = guard_.load();
-  s.ignoredPrograms = ignoredPrograms_.load();
-  s.lastIgnoredProgram = lastIgnoredProgram_.load();
+  for (int w = 0; w < 2; ++w) s.ignoredPrograms[w] = ignoredPrograms_[w].load();
   s.limitedFrames = limitedFrames_.load();
   s.limiterDeepestDb = limiterDeepestDb_.load();
   s.load = load_.load();

@@ -58,13 +58,12 @@ class Player {
     // The callback's time from its start until the last key is rendered, on whichever thread
     // (Synth::process returns only then), over the buffer period: what the deadline sees.
     double load = 0.0, peakLoad = 0.0;
-    long recordDropped = 0;         // samples the recording ring had no room for
-    long late = 0;                  // blocks whose compute time exceeded their period
-    std::uint32_t lastMessage = 0;  // status << 16 | data1 << 8 | data2; 0 before any
-    long limitDrops = 0;            // times the protection lowered the limit
-    double dropLoad = 0.0;          // the highest load of the blocks that made it drop last
-    long ignoredPrograms = 0;       // program changes past the last preset (Synth ignores them)
-    int lastIgnoredProgram = -1;    // the last of them
+    long recordDropped = 0;                 // samples the recording ring had no room for
+    long late = 0;                          // blocks whose compute time exceeded their period
+    std::uint32_t lastMessage = 0;          // status << 16 | data1 << 8 | data2; 0 before any
+    long limitDrops = 0;                    // times the protection lowered the limit
+    double dropLoad = 0.0;                  // the highest load of the blocks that made it drop last
+    std::uint64_t ignoredPrograms[2] = {};  // programs past the last preset asked for (Synth's)
     long limitedFrames = 0;         // frames the master's limiter reduced (0: it never acted)
     double limiterDeepestDb = 0.0;  // and by how much at most, in dB
     // The score has been played to its last message (at once for an empty one) and no key sounds
@@ -99,8 +98,8 @@ class Player {
   double overload_;
   int fullLimit_ = 0, limit_ = 0, overloadedRun_ = 0;
   double reliefTime_ = 0.0, holdTime_ = 0.0, runPeak_ = 0.0;
-  std::atomic<int> voices_{0}, limitShown_{0}, guard_{0}, lastIgnoredProgram_{-1};
-  std::atomic<long> ignoredPrograms_{0};
+  std::atomic<int> voices_{0}, limitShown_{0}, guard_{0};
+  std::atomic<std::uint64_t> ignoredPrograms_[2] = {};
   std::atomic<double> load_{0.0}, peak_{0.0}, dropLoad_{0.0};
   std::atomic<long> recordDropped_{0}, late_{0}, drops_{0}, limitedFrames_{0};
   std::atomic<double> limiterDeepestDb_{0.0};

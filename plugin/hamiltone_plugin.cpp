@@ -111,7 +111,7 @@ class HamiltonePlugin : public Plugin {
       // A whole number, or nothing (a session saved before the key existed): the parameter's.
       char* end = nullptr;
       const long index = std::strtol(value, &end, 10);
-      if (end == value || *end != '\0' || index < 0 || index > 127) return;
+      if (end == value || *end != '\0' || !bundledIndex(static_cast<double>(index))) return;
       setParameterValue(kPreset, static_cast<float>(index));
     }
   }
@@ -121,12 +121,15 @@ class HamiltonePlugin : public Plugin {
     if (String(key) == kStateKeys[kPresetFile]) return String(loader_.file().c_str());
     if (String(key) == kStateKeys[kOverrides]) return String(loader_.overrides().c_str());
     if (String(key) == kStateKeys[kPresetIndex]) {
-      const float index = values_[kPreset].load();  // a host's NaN or inf: the parameter alone
-      return std::isfinite(index) && std::abs(index) < 1e9f
-                 ? String(static_cast<int>(std::lround(index)))
-                 : String();
+      const float index = values_[kPreset].load();  // a host's NaN or 99: the parameter alone
+      return bundledIndex(index) ? String(static_cast<int>(std::lround(index))) : String();
     }
     return String();
+  }
+
+  // A number that rounds to a bundled preset's index.
+  static bool bundledIndex(double index) {
+    return index > -0.5 && index < static_cast<double>(bundledPresets().size()) - 0.5;
   }
 
   void activate() override {

@@ -59,6 +59,7 @@ void PlayingSynth::adopt() noexcept {
   // The pedal held down, the volume turned down and the wheel bent stay so across the swap.
   for (const MidiMessage& m : held_)
     if (m.status != 0) current_->synth.handle(m);
+  current_->synth.settleVolume();
 }
 
 void PlayingSynth::remember(const MidiMessage& m) noexcept {

@@ -72,9 +72,9 @@ std::unique_ptr<BuiltSynth> buildSynth(const SynthRecipe& recipe) {
 
 SynthLoader::~SynthLoader() { stop(); }
 
+// Sequentially consistent, as settle()'s store and load: one of two racing stores is "loading".
 void SynthLoader::setBundled(int index) noexcept {
-  if (bundled_.exchange(index, std::memory_order_relaxed) != index)
-    status_.store(LoadStatus::loading, std::memory_order_release);
+  if (bundled_.exchange(index) != index) status_.store(LoadStatus::loading);
 }
 
 void SynthLoader::setFile(std::string file) { change(file_, std::move(file)); }
@@ -137,7 +137,8 @@ void SynthLoader::build(const SynthRecipe& recipe) {
     std::string why = e.what();
     const bool otherBundled =
         recipe.file.empty() && playing_ && playing_->bundled != recipe.bundled;
-    if (!playing_ || otherBundled || fileUnreadable(recipe)) why += standIn(recipe);
+    if (!playing_ || otherBundled || fileUnreadable(recipe))
+      why += standIn(recipe, /*anyBundled=*/!playing_);
     {
       const std::lock_guard lock(mutex_);
       error_ = why;
@@ -155,13 +156,20 @@ void SynthLoader::publish(std::unique_ptr<BuiltSynth> built) {
 }
 
 // The outcome becomes the status only while `recipe` is still the one asked for: one asked for
-// since (a knob moved during the build) is loading until it is built in turn.
+// since (a knob moved during the build) is loading until it is built in turn. The knob's index
+// is read again after the store: setBundled() stores "loading" after its index, so one of the two
+// stores that race is "loading".
 void SynthLoader::settle(const SynthRecipe& recipe, LoadStatus outcome) {
   const std::lock_guard lock(mutex_);
-  if (wanted() == recipe)
-    status_.store(outcome, std::memory_order_release);
-  else
-    status_.store(LoadStatus::loading, std::memory_order_release);
+  status_.store(wanted() == recipe ? outcome : LoadStatus::loading);
+  if (bundled_.load() != recipe.bundled) status_.store(LoadStatus::loading);
+}
+
+// The same instrument: the same recipe, or the same preset file (the index is not read then).
+bool SynthLoader::playsAlready(const SynthRecipe& playing, const SynthRecipe& recipe) {
+  if (playing == recipe) return true;
+  return !playing.file.empty() && playing.file == recipe.file &&
+         playing.overrides == recipe.overrides && playing.sampleRate == recipe.sampleRate;
 }
 
 bool SynthLoader::fileUnreadable(const SynthRecipe& recipe) {
@@ -175,9 +183,9 @@ bool SynthLoader::fileUnreadable(const SynthRecipe& recipe) {
 }
 
 // The bundled preset the recipe's index names (the first, if it names none) with the recipe's
-// overrides, then without them, then the other bundled presets in their order: the first that
-// builds at the rate is left for take().
-std::string SynthLoader::standIn(const SynthRecipe& refused) {
+// overrides, then without them, then — `anyBundled`, when nothing plays — the other bundled
+// presets in their order: the first that builds at the rate is left for take(). Says which.
+std::string SynthLoader::standIn(const SynthRecipe& refused, bool anyBundled) {
   const auto presets = bundledPresets();
   const int count = static_cast<int>(presets.size());
   const int first = refused.bundled >= 0 && refused.bundled < count ? refused.bundled : 0;
@@ -185,22 +193,24 @@ std::string SynthLoader::standIn(const SynthRecipe& refused) {
   if (!refused.overrides.empty())
     candidates.push_back(
         {.bundled = first, .overrides = refused.overrides, .sampleRate = refused.sampleRate});
-  for (int i = 0; i < count; ++i)
+  for (int i = 0; i < (anyBundled ? count : 1); ++i)
     candidates.push_back({.bundled = (first + i) % count, .sampleRate = refused.sampleRate});
   for (const SynthRecipe& candidate : candidates) {
     if (candidate == refused) continue;  // refused already
-    const std::string playing = std::string("; playing the bundled \"") +
-                                presets[candidate.bundled].name + "\"" +
-                                (candidate.overrides.empty() ? "" : " with the overrides") +
-                                " until a preset that builds is chosen";
-    if (playing_ == candidate) return playing;  // standing in already: not built again
-    try {
-      publish(buildSynth(candidate));
-      return playing;
-    } catch (const std::exception&) {
-      continue;  // the next (at this rate some presets cannot be built)
+    if (!(playing_ == candidate)) {      // standing in already: not built again
+      try {
+        publish(buildSynth(candidate));
+      } catch (const std::exception&) {
+        continue;  // the next (at this rate some presets cannot be built)
+      }
     }
+    return std::string("; playing the bundled \"") + presets[candidate.bundled].name + "\"" +
+           (candidate.overrides.empty() ? "" : " with the overrides") +
+           " until a preset that builds is chosen";
   }
+  if (playing_) return "; the instrument before plays on";
+  if (!(refused.sampleRate > 0.0))
+    return "; the host's sample rate is no rate (8000 to 384000 Hz): silent";
   return "; no bundled preset builds at " + formatNumber(refused.sampleRate) +
          " Hz either: silent until one that does is chosen";
 }
@@ -247,16 +257,19 @@ void SynthLoader::run() {
     const SynthRecipe recipe = wanted();
     if (recipe == attempted_) {  // unchanged, or changed and changed back
       previous = recipe;
-      status_.store(outcome_.load(std::memory_order_acquire), std::memory_order_release);
+      status_.store(outcome_.load());
+      if (bundled_.load() != recipe.bundled) status_.store(LoadStatus::loading);  // as settle()
       continue;
     }
-    // The Preset knob moved while a preset file plays, which wins over it: nothing to build (a
-    // swap would cut every note for the same instrument).
-    if (playing_ && !playing_->file.empty() && playing_->file == recipe.file &&
-        playing_->overrides == recipe.overrides && playing_->sampleRate == recipe.sampleRate) {
+    // What plays already (a stand-in whose file was cleared, overrides refused and taken back,
+    // the knob moved under a preset file, which wins over it): nothing to build — a swap would
+    // cut every note for the same instrument.
+    if (playing_ && playsAlready(*playing_, recipe)) {
       attempted_ = previous = recipe;
-      outcome_.store(LoadStatus::ready, std::memory_order_release);
-      status_.store(LoadStatus::ready, std::memory_order_release);
+      error_.clear();
+      outcome_.store(LoadStatus::ready);
+      status_.store(LoadStatus::ready);
+      if (bundled_.load() != recipe.bundled) status_.store(LoadStatus::loading);  // as settle()
       continue;
     }
     status_.store(LoadStatus::loading, std::memory_order_release);

@@ -71,12 +71,13 @@ class SynthLoader {
   // Any thread: whether the recipe asked for last is waiting or being built (loading from the
   // moment a setter changes it), built, or refused; and (not the audio thread) why it was refused.
   // "ready" comes after take() can return the build, and only while its recipe is still the one
-  // asked for. A refusal leaves the synthesizer playing before; when none has been built since
-  // start(), when the recipe's preset file cannot be read or parsed, or when (with no file) the
-  // bundled index changed to one the overrides do not fit, it leaves a bundled one for take()
-  // instead (the recipe's index first, with its overrides and then without, then the others in
-  // order, each without the file), which the error names. While a preset file plays, a change of
-  // the bundled index alone builds nothing.
+  // asked for. A refusal leaves the synthesizer playing before, but for three cases, where a
+  // bundled one stands in (without the file; the error names it): when none has been built since
+  // start() — the recipe's index with its overrides, then without, then the others in order, the
+  // first that builds; when the recipe's preset file cannot be read or parsed, or (with no file)
+  // the index changed to one the overrides do not fit — that index, with its overrides, then
+  // without (if neither builds at the rate, the one before plays on). A recipe of the instrument
+  // that plays (the same recipe, or the same file whatever the index) builds nothing.
   LoadStatus status() const noexcept { return status_.load(std::memory_order_acquire); }
   std::string error() const;
 
@@ -88,8 +89,9 @@ class SynthLoader {
   void build(const SynthRecipe& recipe);            // into built_, or the status failed
   void publish(std::unique_ptr<BuiltSynth> built);  // into built_, as playing_
   void settle(const SynthRecipe& recipe, LoadStatus outcome);
+  static bool playsAlready(const SynthRecipe& playing, const SynthRecipe& recipe);
   static bool fileUnreadable(const SynthRecipe& recipe);  // its file, alone, cannot be loaded
-  std::string standIn(const SynthRecipe& refused);        // a bundled one instead; says which
+  std::string standIn(const SynthRecipe& refused, bool anyBundled);  // says which
   void freeGivenBack();
   void run();
 
@@ -98,14 +100,15 @@ class SynthLoader {
   std::atomic<LoadStatus> outcome_{LoadStatus::loading};  // of the recipe attempted last
   std::atomic<BuiltSynth*> built_{nullptr}, givenBack_{nullptr};
 
+  // The recipe of the synthesizer built last since start(), if any: only the loader's thread
+  // touches it, and start() before that thread exists.
+  std::optional<SynthRecipe> playing_;
+
   mutable std::mutex mutex_;  // guards what follows; never taken by the audio thread
   std::condition_variable wake_;
   std::string file_, overrides_, error_;
   double sampleRate_ = 48000.0;
   SynthRecipe attempted_;  // the recipe built last, successfully or not
-  // The recipe of the synthesizer built last since start(), if any: the loader's thread's (or
-  // start's).
-  std::optional<SynthRecipe> playing_;
   bool stopping_ = false;
   std::thread thread_;
 };

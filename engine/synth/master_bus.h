@@ -85,6 +85,7 @@ class MasterBus {
   void prepare(double sampleRate);  // also clears the meters
   void reset();                     // the filters and the limiter; keeps the meters
   void setVolume(double gain) { volumeTarget_ = gain; }  // linear, ≥ 0
+  void settleVolume() { volume_ = volumeTarget_; }       // at once, without the smoothing
 
   // In place over both channels. Counts the non-finite samples it replaced by zero.
   void process(std::span<float> left, std::span<float> right) noexcept;

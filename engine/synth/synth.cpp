@@ -90,8 +90,7 @@ void Synth::prepare(std::vector<Instrument> instruments, const SynthSetup& setup
   master_ = master;
   maxBlock_ = setup.maxBlock;
   program_ = 0;
-  ignoredPrograms_ = 0;
-  lastIgnoredProgram_ = -1;
+  ignoredPrograms_[0] = ignoredPrograms_[1] = 0;
   std::fill(std::begin(downProgram_), std::end(downProgram_), -1);
   contact_ = 1.0;
   sostenuto_ = unaCorda_ = false;
@@ -331,8 +330,8 @@ void Synth::handle(const MidiMessage& m) noexcept {
       if (m.data1 < instruments_.size()) {
         program_ = m.data1;
       } else {
-        ++ignoredPrograms_;
-        lastIgnoredProgram_ = m.data1;
+        const int p = m.data1 & 0x7F;
+        ignoredPrograms_[p / 64] |= std::uint64_t{1} << (p % 64);
       }
       break;
     default:

@@ -4,6 +4,7 @@
 // the worker threads (SynthSetup::threads) are handed over without a lock (synth/worker_pool.h).
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <span>
 #include <utility>
@@ -91,10 +92,12 @@ class Synth {
   // DC-blocker tail at most. (activeVoices() does not count a key fading out.)
   bool silent() const;
   int program() const { return program_; }
-  // Program changes to a program past the last instrument, since prepare(), and the last one's
-  // number (−1 before any): ignored, so that a front end can say so.
-  long ignoredProgramChanges() const { return ignoredPrograms_; }
-  int lastIgnoredProgram() const { return lastIgnoredProgram_; }
+  // The CC7 volume at its last value at once, not smoothed from where it was: for a synthesizer
+  // that takes over the controllers of another (the plugin's swap), whose volume was never full.
+  void settleVolume() noexcept { master_.settleVolume(); }
+  // The programs past the last instrument that program changes asked for since prepare(), a bit
+  // each (program p: bit p % 64 of word p / 64): ignored, so that a front end can say so.
+  std::uint64_t ignoredPrograms(int word) const { return ignoredPrograms_[word]; }
   int guardEvents() const;
   long nonFiniteSamples() const { return master_.nonFinite(); }
   // The master's limiter and its meters since prepare(): how often and how deep it acted.
@@ -165,8 +168,7 @@ class Synth {
   MasterBus master_;
   int maxBlock_ = 0;
   int program_ = 0, polyphonyOverride_ = 0;
-  long ignoredPrograms_ = 0;
-  int lastIgnoredProgram_ = -1;
+  std::uint64_t ignoredPrograms_[2] = {};
   int downProgram_[128];  // which instrument's voice a held note struck (−1: none)
   bool sostenuto_ = false, unaCorda_ = false;
   double contact_ = 1.0;  // of the dampers of the keys released under the pedal (damperContact)

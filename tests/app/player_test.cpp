@@ -419,25 +419,23 @@ TEST(Player, FinishedOnceTheScoreIsPlayedAndSilent) {
 }
 
 // A program change past the last preset, live or scored, is ignored by the synthesizer and
-// counted in the status, with its number, for the main thread to say (it was silent).
+// marked in the status, a bit a program, for the main thread to say each once (it was silent).
 TEST(Player, ProgramChangesPastTheLastPresetAreCountedInTheStatus) {
   constexpr int kFrames = 256;
   const TimedMessage score[] = {{0.0, {0xC0, 5, 0}}};
   Synth synth = prepared({pianoKeys(48, 52)});
   SpscQueue<StampedMessage> midi(16);
   Player player(synth, midi, nullptr, kRate, kFrames);
-  EXPECT_EQ(player.status().ignoredPrograms, 0);
-  EXPECT_EQ(player.status().lastIgnoredProgram, -1);
+  EXPECT_EQ(player.status().ignoredPrograms[0], 0u);
   player.setScore(score);
   std::vector<float> interleaved(2 * kFrames);
   player.render(interleaved.data(), kFrames, kNow);
-  EXPECT_EQ(player.status().ignoredPrograms, 1);
-  EXPECT_EQ(player.status().lastIgnoredProgram, 5);
-  ASSERT_TRUE(midi.push({before(10), {0xC3, 9, 0}}));  // live, on another channel
-  ASSERT_TRUE(midi.push({before(5), {0xC0, 0, 0}}));   // the one preset: taken
+  EXPECT_EQ(player.status().ignoredPrograms[0], std::uint64_t{1} << 5);
+  ASSERT_TRUE(midi.push({before(10), {0xC3, 100, 0}}));  // live, on another channel
+  ASSERT_TRUE(midi.push({before(5), {0xC0, 0, 0}}));     // the one preset: taken
   player.render(interleaved.data(), kFrames, kNow);
-  EXPECT_EQ(player.status().ignoredPrograms, 2);
-  EXPECT_EQ(player.status().lastIgnoredProgram, 9);
+  EXPECT_EQ(player.status().ignoredPrograms[0], std::uint64_t{1} << 5);
+  EXPECT_EQ(player.status().ignoredPrograms[1], std::uint64_t{1} << (100 - 64));
 }
 
 // With endRecording (hamiltone-play --midi/--notes, which then exits), the recording ends with the

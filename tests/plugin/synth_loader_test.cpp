@@ -109,6 +109,23 @@ TEST(SynthLoader, StartBuildsNowAndChangesAreBuiltAwayFromTheCaller) {
   loader.stop();
 }
 
+// The Preset knob moved, while a preset plays, to one that cannot be built at the host's rate (the
+// grand piano at 16 kHz): the preset before plays on, not another bundled one nobody chose.
+TEST(SynthLoader, AKnobMovedToAPresetThatCannotBeBuiltLeavesTheOneBeforePlaying) {
+  SynthLoader loader;
+  loader.setBundled(3);
+  loader.start(16000.0);
+  ASSERT_EQ(loader.status(), LoadStatus::ready) << loader.error();
+  std::unique_ptr<BuiltSynth> gong(loader.take());
+  ASSERT_TRUE(gong);
+  loader.setBundled(0);
+  ASSERT_EQ(settled(loader), LoadStatus::failed);
+  EXPECT_EQ(loader.take(), nullptr);
+  EXPECT_NE(loader.error().find("the instrument before plays on"), std::string::npos)
+      << loader.error();
+  loader.stop();
+}
+
 // A session restored where its preset file is gone: nothing played before, so the bundled preset
 // the Preset parameter names plays instead of silence, and the error says both.
 TEST(SynthLoader, ARefusedFirstRecipeLeavesABundledPresetToPlay) {
@@ -143,9 +160,21 @@ TEST(SynthLoader, ARefusedFirstRecipeLeavesABundledPresetToPlay) {
   ASSERT_TRUE(chosen);
   EXPECT_EQ(chosen->recipe, (SynthRecipe{.bundled = 4, .sampleRate = 48000.0}));
 
+  // The file cleared, the overrides still refused: the stand-in plays on. Then the overrides
+  // cleared: the recipe is the stand-in's own, so nothing is built (a swap would cut its notes)
+  // and the refusal is over.
+  loader.setFile("");
+  ASSERT_EQ(settled(loader), LoadStatus::failed);
+  EXPECT_EQ(loader.take(), nullptr);
+  loader.setOverrides("");
+  ASSERT_EQ(settled(loader), LoadStatus::ready);
+  std::this_thread::sleep_for(std::chrono::milliseconds(5 * SynthLoader::kPollMs));
+  EXPECT_EQ(loader.take(), nullptr);
+  EXPECT_EQ(loader.error(), "");
+
   // A new start() (the host activating again) has nothing playing: it stands in again.
   loader.stop();
-  loader.setOverrides("");
+  loader.setFile("/nonexistent/session/preset.toml");
   loader.start(44100.0);
   std::unique_ptr<BuiltSynth> again(loader.take());
   ASSERT_TRUE(again);
