@@ -317,16 +317,13 @@ int play(const PlayArguments& a) {
     if (!limitLine.empty())
       std::fprintf(stderr, "%shamiltone-play: %s\n", status ? "\n" : "", limitLine.c_str());
     // Program changes past the last preset (live or in the score): each program said once.
-    std::string programs;
+    std::vector<bool> unsaid(128, false);
     for (int p = 0; p < 128; ++p) {
       const std::uint64_t bit = std::uint64_t{1} << (p % 64);
-      if ((s.ignoredPrograms[p / 64] & bit) && !(ignoredShown[p / 64] & bit)) {
-        ignoredShown[p / 64] |= bit;
-        programs += ' ';
-        programs += std::to_string(p);
-      }
+      unsaid[p] = (s.ignoredPrograms[p / 64] & bit) && !(ignoredShown[p / 64] & bit);
     }
-    if (!programs.empty())
+    for (int w = 0; w < 2; ++w) ignoredShown[w] = s.ignoredPrograms[w];
+    if (const std::string programs = cli::numberList(unsaid); !programs.empty())
       std::fprintf(stderr, "%shamiltone-play: warning: %s\n", status ? "\n" : "",
                    cli::ignoredProgramText(programs, synth.instruments().size()).c_str());
     // The keyboard's port, once a second: unplugged, or its program gone; back, or (on JACK)

@@ -31,12 +31,10 @@ std::vector<PresetOverride> overridesOf(const std::string& text) {
     const size_t first = piece.find_first_not_of(" \t\r");
     if (first == std::string::npos || piece[first] == '#') continue;
     std::optional<PresetOverride> o = parseOverride(piece);
-    if (!o) {
-      // A host's log takes one line: a megabyte of junk is named by its start.
-      constexpr size_t kShown = 60;
-      const std::string shown = piece.size() > kShown ? piece.substr(0, kShown) + "…" : piece;
-      throw std::invalid_argument("overrides: \"" + shown + "\": expected NAME=VALUE");
-    }
+    // A host's log takes one line: a megabyte of junk is named by its start.
+    if (!o)
+      throw std::invalid_argument("overrides: " + shownInMessage(piece, true) +
+                                  ": expected NAME=VALUE");
     overrides.push_back(std::move(*o));
   }
   return overrides;

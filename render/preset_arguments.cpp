@@ -76,13 +76,7 @@ std::string unplayedNotes(std::span<const TimedMessage> messages,
     const Instrument& i = instruments[program];
     if (note < i.lowestNote || note > i.highestNote) silent[note] = true;
   }
-  std::string outside;
-  for (int note = 0; note < 128; ++note) {
-    if (!silent[note]) continue;
-    outside += ' ';
-    outside += std::to_string(note);
-  }
-  return outside;
+  return numberList(silent);
 }
 
 std::string unloadedPrograms(std::span<const TimedMessage> messages, size_t loaded) {
@@ -90,13 +84,17 @@ std::string unloadedPrograms(std::span<const TimedMessage> messages, size_t load
   for (const TimedMessage& m : messages)
     if (m.message.kind() == midi::program && m.message.data1 >= loaded)
       asked[m.message.data1 & 0x7F] = true;
-  std::string programs;
-  for (int p = 0; p < 128; ++p)
-    if (asked[p]) {
-      programs += ' ';
-      programs += std::to_string(p);
-    }
-  return programs;
+  return numberList(asked);
+}
+
+std::string numberList(const std::vector<bool>& set) {
+  std::string list;
+  for (size_t n = 0; n < set.size(); ++n) {
+    if (!set[n]) continue;
+    list += ' ';
+    list += std::to_string(n);
+  }
+  return list;
 }
 
 std::string ignoredProgramText(const std::string& programs, size_t loaded) {

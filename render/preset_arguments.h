@@ -36,6 +36,8 @@ std::string unplayedNotes(std::span<const TimedMessage> messages,
 // The programs `messages` change to that are not loaded (Synth ignores them), as " 3 7", each
 // once, in order (empty when every one is loaded).
 std::string unloadedPrograms(std::span<const TimedMessage> messages, size_t loaded);
+// The numbers n with set[n], as " 3 7", in order (empty for none): the lists of the warnings.
+std::string numberList(const std::vector<bool>& set);
 // Why such a change is ignored and what would play it: "program change to 3 is ignored: 1 preset
 // is loaded (program 0); give --preset once per program (the first is program 0)".
 std::string ignoredProgramText(const std::string& programs, size_t loaded);

@@ -46,8 +46,9 @@ struct Blame {
   std::string text;
 };
 
-// At most kMaxShown bytes of `s`, cut at a character boundary; control characters become '?'.
-std::string clip(std::string_view s, bool quoted) {
+}  // namespace
+
+std::string shownInMessage(std::string_view s, bool quoted) {
   size_t n = std::min(s.size(), kMaxShown);
   while (n > 0 && n < s.size() && (static_cast<unsigned char>(s[n]) & 0xC0) == 0x80) --n;
   std::string out = quoted ? "\"" : "";
@@ -59,8 +60,10 @@ std::string clip(std::string_view s, bool quoted) {
   return quoted ? out + "\"" : out;
 }
 
+namespace {
+
 std::string show(const toml::node& v) {
-  if (const auto* s = v.as_string()) return clip(s->get(), true);
+  if (const auto* s = v.as_string()) return shownInMessage(s->get(), true);
   if (const auto* i = v.as_integer()) return std::to_string(i->get());
   if (const auto* f = v.as_floating_point()) return compactNumber(f->get());
   if (const auto* b = v.as_boolean()) return b->get() ? "true" : "false";
@@ -491,7 +494,8 @@ void Loader::readAnchor(const toml::table& table, size_t ordinal) {
 // per-key one the anchors' values too, so that it holds at every key.
 void Loader::readOverrides(const std::vector<PresetOverride>& overrides, const std::string& label) {
   for (const PresetOverride& o : overrides) {
-    overrides_.push_back(label + clip(o.name, false) + "=" + clip(o.value, false));
+    overrides_.push_back(label + shownInMessage(o.name, false) + "=" +
+                         shownInMessage(o.value, false));
     const Place at{.set = static_cast<int>(overrides_.size())};
     if (o.name == "model") {
       error(at, overrides_.back() +
@@ -516,7 +520,7 @@ std::string Loader::said(const std::string& name, const std::string& shown, Plac
 
 void Loader::entry(std::string name, const toml::node& value, Place at, Settings& into,
                    const std::string& label) {
-  const std::string shownName = (label.empty() ? "" : label + ".") + clip(name, false);
+  const std::string shownName = (label.empty() ? "" : label + ".") + shownInMessage(name, false);
   const std::string head = said(shownName, show(value), at);
   const Parameter* any = findParameter(name);
   if (!any || sectionOf(name) == "key") {

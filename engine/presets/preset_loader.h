@@ -34,6 +34,10 @@ struct PresetOverride {
 // "NAME=VALUE" split at the first '=', blanks around each dropped; nothing without '=' or NAME.
 std::optional<PresetOverride> parseOverride(std::string_view argument);
 
+// `s` as the messages quote a name or a value: at most 40 bytes, cut at a character boundary with
+// "…" after the cut, control characters as '?'; `quoted`: in double quotes, " and \ escaped.
+std::string shownInMessage(std::string_view s, bool quoted);
+
 // The rate the loader prepares voices at to check a preset when the playing rate is not known.
 constexpr double kCheckRate = 48000.0;
 
