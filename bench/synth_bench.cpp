@@ -3,7 +3,7 @@
 // "x_realtime" is seconds of audio per second of CPU: above 1 the chord plays in real time on one
 // core (threads = 1: every key on the calling thread). The summary names the largest N that does.
 // Beside it, the cost of one grand-piano key across the keyboard on each string grid rule, and the
-// ratio of the two-grid to the transverse.
+// ratio of the two-grid to the transverse; and of single keys by register (key/…).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -54,8 +54,24 @@ void keyboard(benchmark::State& state) {
   state.SetLabel(std::string(rule) + (tail ? "" : ", no tail"));
 }
 
+// One key alone, all its unison strings on their bridge (body off), on each grid rule: A0, C3, C6
+// and C7, where `keyboard` gives the mean of fifteen keys. The treble's one-cell strings (C6, C7)
+// spend most of a step on work that does not scale with the grid.
+void key(benchmark::State& state) {
+  const int note = static_cast<int>(state.range(0));
+  const char* rule = kGridRules[state.range(1)];
+  PresetOptions options{.overrides = {{"scheme.grid_rule", rule}, {"body.enabled", "false"}}};
+  const Instrument piano = loadPreset(HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml", options);
+  playHeldKeys(state, piano, {note}, 256, kRestrikeS);
+}
+
 }  // namespace
 }  // namespace hamiltone
+
+BENCHMARK(hamiltone::key)
+    ->ArgNames({"note", "rule"})
+    ->ArgsProduct({{21, 48, 84, 96}, {0, 1}})
+    ->Unit(benchmark::kMicrosecond);
 
 BENCHMARK(hamiltone::keyboard)
     ->ArgNames({"rule", "tail"})

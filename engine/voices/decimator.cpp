@@ -57,11 +57,7 @@ void Decimator::reset() {
   head_ = 0;
 }
 
-bool Decimator::push(double in, double& out) noexcept {
-  if (factor_ == 1) {  // the one tap 1.0: the filter's sum, 0 + 1·in, bit for bit (−0 gives +0)
-    out = in + 0.0;
-    return true;
-  }
+bool Decimator::filter(double in, double& out) noexcept {
   const int n = static_cast<int>(taps_.size());
   history_[head_] = in;
   history_[head_ + n] = in;

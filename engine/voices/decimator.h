@@ -15,9 +15,17 @@ class Decimator {
   int factor() const { return factor_; }
 
   // Feed one input sample; returns true when an output sample is ready in `out`.
-  bool push(double in, double& out) noexcept;
+  bool push(double in, double& out) noexcept {
+    if (factor_ == 1) {  // the one tap 1.0: the filter's sum, 0 + 1·in, bit for bit (−0 gives +0)
+      out = in + 0.0;
+      return true;
+    }
+    return filter(in, out);
+  }
 
  private:
+  bool filter(double in, double& out) noexcept;  // factor > 1
+
   int factor_ = 1;
   int phase_ = 0;
   int head_ = 0;

@@ -358,7 +358,10 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
   linearisable_ = linearisable;
   scheme_ = std::move(scheme);
   atRest_ = std::move(atRest);
-  for (int c = 0; c < 2; ++c) decimators_[c] = std::move(decimators[c]);
+  for (int c = 0; c < 2; ++c) {
+    decimators_[c] = std::move(decimators[c]);
+    taps_[c] = pickupTap(patch.pickups[c], segments());
+  }
   quiet_.prepare(sampleRate);
   reset();
 }
@@ -492,13 +495,17 @@ void StringVoice::catchHammer() noexcept {
   parked_ = true;
 }
 
-double StringVoice::pickup(const Vector& q, const Vector& qNext, double position) const {
-  const int m = segments();
+StringVoice::PickupTap StringVoice::pickupTap(double position, int m) {
   const double s = std::clamp(position * m - 1.0, 0.0, m - 2.0);  // grid index, x = (j + 1) h
   const int j = std::min(static_cast<int>(s), m - 2);
   const double f = s - j;
-  const int j1 = std::min(j + 1, m - 2);
-  auto at = [&](const Vector& x) { return (1.0 - f) * x[j] + f * x[j1]; };
+  return {j, std::min(j + 1, m - 2), 1.0 - f, f};
+}
+
+double StringVoice::pickup(const Vector& q, const Vector& qNext, const PickupTap& tap) const {
+  auto at = [&](const Vector& x) {
+    return tap.weight * x[tap.node] + tap.nextWeight * x[tap.next];
+  };
   if (patch_.signal == PickupSignal::displacement) return at(q);
   return (at(qNext) - at(q)) / k_;
 }
@@ -545,7 +552,7 @@ bool StringVoice::stepAndPick(double out[2]) noexcept {
   const Vector& qNext = scheme_->qNext();
   bool ready = false;
   for (int c = 0; c < patch_.channels; ++c)
-    ready = decimators_[c].push(pickup(q, qNext, patch_.pickups[c]), out[c]);
+    ready = decimators_[c].push(pickup(q, qNext, taps_[c]), out[c]);
   return ready;
 }
 

@@ -164,7 +164,14 @@ class StringVoice {
   const SplitSav<HammeredString>& scheme() const { return *scheme_; }
 
  private:
-  double pickup(const Vector& q, const Vector& qNext, double position) const;
+  // A pickup at a fraction of L: the two nodes of u around it and their linear weights, fixed
+  // when the voice is prepared (the grid does not change with the bend).
+  struct PickupTap {
+    int node, next;
+    double weight, nextWeight;
+  };
+  static PickupTap pickupTap(double position, int segments);
+  double pickup(const Vector& q, const Vector& qNext, const PickupTap& tap) const;
   void catchHammer() noexcept;
   void applyBend() noexcept;
   bool stepAndPick(double out[2]) noexcept;  // one scheme step; true when a sample is out
@@ -175,6 +182,7 @@ class StringVoice {
   std::unique_ptr<SplitSav<HammeredString>> scheme_;
   std::unique_ptr<SplitSav<HammeredString>> atRest_;  // the reset state, copied in reset()
   Decimator decimators_[2];
+  PickupTap taps_[2] = {};
   QuietDetector quiet_;
   StringLoss loss_;
   BridgeCoupling coupling_;  // of the string as bent now
