@@ -304,8 +304,55 @@ void NonlinearString::cellStrains(const Vector& q, double* strain, double* inver
                           inverseStretch);
 }
 
+// One coarse cell (Mv = 1: the strings shorter than 2.1 √(E/ρ) k, the Kirchhoff–Carrier limit of
+// SCHEMES §3b): v has no unknowns, so η = 0, S = sqrt(1 + Z) with Z = (1/M) Σ_l ζ_l² the mean
+// square slope of the whole string, read from u in place (ζ_0 = u_0/h, ζ_{M−1} = −u_{M−2}/h).
+NonlinearString::OneCell NonlinearString::oneCell(const Vector& q) const {
+  const Eigen::Index m = segments_;
+  const double* u = q.data();
+  const double invH = 1.0 / h_;
+  const double first = u[0] * invH, last = u[m - 2] * invH;
+  double sum = first * first + last * last;
+#pragma omp simd reduction(+ : sum)
+  for (Eigen::Index l = 1; l < m - 1; ++l) {
+    const double zeta = (u[l] - u[l - 1]) * invH;
+    sum += zeta * zeta;
+  }
+  const double mean = sum / static_cast<double>(m);
+  const double stretch = std::sqrt(1.0 + mean);
+  return {mean / (stretch + 1.0), stretch};  // ε = S − 1 without cancellation
+}
+
+// Its gradient, the two grids' with r = M and η = 0: ∂V'/∂ζ_l = c (ε/S) ζ_l, so
+// ∇_u V' = D₋ᵀ(c (ε/S) ζ) = c (ε/S) (2u_j − u_{j−1} − u_{j+1}) / h², one sweep where the cells'
+// kernels take four and a copy; the tension at the end, c M ε/(S h_v).
+double NonlinearString::oneCellGradient(const Vector& q, Vector& grad) const {
+  const Eigen::Index m = segments_;
+  const double* u = q.data();
+  double* gu = grad.data();
+  const OneCell cell = oneCell(q);
+  const double c = (physics_.young * physics_.area - physics_.tension) * h_;
+  const double weight = c * cell.strain / cell.stretch;
+  const double f = weight / (h_ * h_);
+  if (m == 2) {
+    gu[0] = 2.0 * f * u[0];
+  } else {
+    gu[0] = f * (2.0 * u[0] - u[1]);
+    gu[m - 2] = f * (2.0 * u[m - 2] - u[m - 3]);
+#pragma omp simd
+    for (Eigen::Index j = 1; j < m - 2; ++j) gu[j] = f * (2.0 * u[j] - u[j - 1] - u[j + 1]);
+  }
+  endTension_ = weight * static_cast<double>(m) / hv_;
+  return 0.5 * hv_ * (physics_.young * physics_.area - physics_.tension) * cell.strain *
+         cell.strain;
+}
+
 // V' = (EA − T0)/2 Σ_J h_v ε_J².
 double NonlinearString::twoGridPotential(const Vector& q) const {
+  if (grid_.longitudinal == 1) {
+    const double strain = oneCell(q).strain;
+    return 0.5 * hv_ * (physics_.young * physics_.area - physics_.tension) * strain * strain;
+  }
   double* strain = cell2_.data();
   cellStrains(q, strain, cell3_.data(), work1_.data());
   double sum = 0.0;
@@ -318,6 +365,7 @@ double NonlinearString::twoGridPotential(const Vector& q) const {
 // then ∇_u V' = D₋ᵀ(∂V'/∂ζ) on the fine grid and ∇_v V' = D₋ᵀ(∂V'/∂η) on the coarse one.
 double NonlinearString::twoGridGradient(const Vector& q, Vector& grad) const {
   const Eigen::Index m = segments_, mv = grid_.longitudinal;
+  if (mv == 1) return oneCellGradient(q, grad);
   const double c = (physics_.young * physics_.area - physics_.tension) * h_;
   double* zeta = work1_.data();
   double* we = cell2_.data();      // ε_J, then ∂V'/∂η_J

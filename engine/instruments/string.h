@@ -135,6 +135,11 @@ class NonlinearString {
   double singleGridGradient(const Vector& q, Vector& grad) const;
   double twoGridPotential(const Vector& q) const;
   double twoGridGradient(const Vector& q, Vector& grad) const;
+  struct OneCell {
+    double strain, stretch;  // ε = S − 1 and S of the string's one coarse cell
+  };
+  OneCell oneCell(const Vector& q) const;
+  double oneCellGradient(const Vector& q, Vector& grad) const;
   void cellStrains(const Vector& q, double* strain, double* inverseStretch, double* zeta) const;
   void longitudinalStiffness(const Vector& q, Vector& out) const;              // K q on v
   void longitudinalLoss(const Vector& a, const Vector& b, Vector& out) const;  // C(a − b) on v
