@@ -486,7 +486,9 @@ def run(ctx):
            "against one per segment)"
            + (f"; on {', '.join(finer)} u's grid is even finer on the two-grid rule (sized for "
               "1.5 T0) than on the transverse rule (sized for the bend range's tension)"
-              if finer else "") + ".")
+              if finer else "") + ". These are single strings, each waiting on its own steps; a "
+           "key's two or three unison strings, which the CPU steps side by side, measure lower "
+           "(docs/string-grids.md, \"A key's strings against a string alone\").")
         + (f" On {', '.join(no_long)} the coarse grid has a single cell (Mv = 1, the "
            "Kirchhoff–Carrier limit of SCHEMES §3b): no longitudinal modes at all." if no_long
            else "")
