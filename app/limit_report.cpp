@@ -7,6 +7,15 @@ namespace hamiltone::app {
 
 std::string LimitReport::update(const Player::Status& status, double seconds) {
   char line[512];
+  if (status.liveTails > 0 && !tailsSaid_) {
+    tailsSaid_ = true;
+    std::snprintf(line, sizeof line,
+                  "live tails on: the audio callback took over %.0f%% of its period, so decaying "
+                  "strings now go linear sooner (pitch moved by under a cent) before any voice "
+                  "is dropped",
+                  100.0 * Player::kTailShare * context_.budget);
+    return line;
+  }
   if (status.limitDrops > reportedDrops_) {
     // Once every kInterval, whether or not the limit came back in between: a load that hovers at
     // the budget takes it down and back every second or so.

@@ -3,7 +3,7 @@
 // line every kInterval seconds, even when the limit came back in between, saying how often it
 // dropped since the last line, the callback's load that made it drop against the budget, the new
 // limit (or that it is back already), and what would avoid it. And one line when the limit is back
-// at the polyphony.
+// at the polyphony. Once, the first time the protection turns the strings' live tail on.
 #pragma once
 
 #include <string>
@@ -34,8 +34,9 @@ class LimitReport {
   LimitContext context_;
   long reportedDrops_ = 0;
   double lastLine_ = 0.0;
-  bool lowered_ = false;  // a drop was reported and the limit is not back yet
-  bool said_ = false;     // a drop was reported (at lastLine_)
+  bool lowered_ = false;    // a drop was reported and the limit is not back yet
+  bool said_ = false;       // a drop was reported (at lastLine_)
+  bool tailsSaid_ = false;  // the live tail's first turn on was reported
 };
 
 }  // namespace hamiltone::app

@@ -361,9 +361,9 @@ int play(const PlayArguments& a) {
     if (!status) continue;
     std::fprintf(stderr,
                  "\r  voices %2d/%-3d  cpu %3.0f%% (peak %3.0f%%)  underruns %ld (late %ld)  "
-                 "midi %-12s  guard %d%s   ",
+                 "midi %-12s  guard %d%s%s   ",
                  s.voices, s.limit, 100.0 * s.load, 100.0 * s.peakLoad, audio.underruns(), s.late,
-                 describe(s.lastMessage).c_str(), s.guardEvents,
+                 describe(s.lastMessage).c_str(), s.guardEvents, s.liveTail ? "  live tails" : "",
                  recordingFailureShown ? "  REC STOPPED" : "");
     std::fflush(stderr);
   }
@@ -459,7 +459,8 @@ int runMain(int argc, char** argv) {
                        "(default: one per core); the sound is the same whatever N");
   cli::addNumberOption(&app, "--cpu-limit", a.cpuLimit, "PERCENT",
                        "share of the buffer period the audio callback may take before the voice "
-                       "limit drops, above 0, at most 100");
+                       "limit drops (from three quarters of it the strings' tails go linear "
+                       "sooner), above 0, at most 100");
   app.add_flag("--list-devices", a.listDevices, "list the APIs, output devices and MIDI ports");
   app.add_flag("--quiet", a.quiet, "no status line");
   app.footer(

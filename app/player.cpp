@@ -134,6 +134,7 @@ void Player::render(float* interleaved, int frames, std::int64_t nowNs) noexcept
 // since a key fading out (5 ms) is no longer counted but still costs its time — and then it came
 // back a key per second at best.
 void Player::protect(double load, double blockSeconds) noexcept {
+  protectTails(load, blockSeconds);
   const int floor = std::min(fullLimit_, kFloorVoices);
   holdTime_ = std::max(0.0, holdTime_ - blockSeconds);
   if (load > overload_) {
@@ -164,6 +165,29 @@ void Player::protect(double load, double blockSeconds) noexcept {
   limitShown_.store(limit_, std::memory_order_relaxed);
 }
 
+// The first step, at kTailShare of the budget: the strings' live tail, which costs no key and
+// moves a decaying string's pitch by under a cent. Off again only after kTailRelief seconds of
+// light load, since turning it off raises the load it lowered.
+void Player::protectTails(double load, double blockSeconds) noexcept {
+  const bool on = liveTail_.load(std::memory_order_relaxed);
+  if (load > kTailShare * overload_) {
+    tailReliefTime_ = 0.0;
+    if (++tailRun_ >= kOverloadedBlocks && !on) {
+      synth_.setLiveTail(true);
+      liveTail_.store(true, std::memory_order_relaxed);
+      liveTails_.fetch_add(1, std::memory_order_relaxed);
+    }
+    return;
+  }
+  tailRun_ = 0;
+  tailReliefTime_ = on && load < kRelief ? tailReliefTime_ + blockSeconds : 0.0;
+  if (tailReliefTime_ >= kTailRelief) {
+    synth_.setLiveTail(false);
+    liveTail_.store(false, std::memory_order_relaxed);
+    tailReliefTime_ = 0.0;
+  }
+}
+
 std::optional<pthread_t> Player::callbackThread() const {
   if (!callbackKnown_.load(std::memory_order_acquire)) return std::nullopt;
   return callbackThread_;
@@ -183,6 +207,8 @@ Player::Status Player::status() const {
   s.late = late_.load();
   s.lastMessage = last_.load();
   s.limitDrops = drops_.load();
+  s.liveTail = liveTail_.load();
+  s.liveTails = liveTails_.load();
   s.dropLoad = dropLoad_.load();
   s.finished = finished_.load();
   return s;

@@ -89,6 +89,10 @@ void KeyVoice::setBend(double semitones) noexcept {
   if (UnisonStrings* strings = std::get_if<UnisonStrings>(&voice_)) strings->setBend(semitones);
 }
 
+void KeyVoice::setLiveTail(bool on) noexcept {
+  if (UnisonStrings* strings = std::get_if<UnisonStrings>(&voice_)) strings->setLiveTail(on);
+}
+
 double KeyVoice::level() const {
   if (sinceStrike_ < attackSamples_) return 1.0;
   return loudest_ > 0.0 ? envelope_ / loudest_ : 0.0;

@@ -93,7 +93,7 @@ void Synth::prepare(std::vector<Instrument> instruments, const SynthSetup& setup
   ignoredPrograms_[0] = ignoredPrograms_[1] = 0;
   std::fill(std::begin(downProgram_), std::end(downProgram_), -1);
   contact_ = 1.0;
-  sostenuto_ = unaCorda_ = false;
+  sostenuto_ = unaCorda_ = liveTail_ = false;
   bend_ = 0.0;
   strikes_ = steals_ = 0;
   loudestSteal_ = 0.0;
@@ -269,6 +269,12 @@ void Synth::setBend(double fraction) noexcept {
   for (size_t p = 0; p < voices_.size(); ++p)
     for (KeyVoice& v : voices_[p])
       if (v.sounding()) v.setBend(bend_ * instruments_[p].bendRange);
+}
+
+void Synth::setLiveTail(bool on) noexcept {
+  liveTail_ = on;
+  for (auto& keys : voices_)
+    for (KeyVoice& v : keys) v.setLiveTail(on);
 }
 
 void Synth::allSoundOff() noexcept {

@@ -82,6 +82,13 @@ class Synth {
   // felt's pressure on the string, and with it the loss it adds, grows with the way it is pressed
   // in. So 0 and 127 are today's up and down to the bit, and 64 is a half pedal (contact 0.45).
   static double damperContact(int value) noexcept;
+  // Every string key's live tail (StringVoice::setLiveTail): on, a decaying string goes linear at
+  // a tension modulation of 1e-3 rather than its preset's (1e-4 on grand-piano), at about half
+  // the cost a step, its pitch off by at most 0.87 cents. For a live player under load, before it
+  // drops keys (app::Player); renders never take it, so their output stays the preset's. Off: the
+  // strings not yet linear go on to the preset's threshold, the linear ones stay linear.
+  void setLiveTail(bool on) noexcept;
+  bool liveTail() const { return liveTail_; }
   // How a note-off's release velocity scales its damper's T60: 2^((64 − v)/63) — a key let go
   // fast (127) damps in half the time, a slow one (1) in twice, 64 as the preset says; 0 (no
   // velocity given, or a note-on at velocity 0) is 1.
@@ -171,6 +178,7 @@ class Synth {
   std::uint64_t ignoredPrograms_[2] = {};
   int downProgram_[128];  // which instrument's voice a held note struck (−1: none)
   bool sostenuto_ = false, unaCorda_ = false;
+  bool liveTail_ = false;
   double contact_ = 1.0;  // of the dampers of the keys released under the pedal (damperContact)
   double bend_ = 0.0;     // −1 … 1 of the range
   double damperScale_ = 1.0;

@@ -60,6 +60,10 @@ void UnisonStrings::setBend(double semitones) noexcept {
   for (StringVoice& s : strings_) s.setBend(semitones);
 }
 
+void UnisonStrings::setLiveTail(bool on) noexcept {
+  for (StringVoice& s : strings_) s.setLiveTail(on);
+}
+
 void UnisonStrings::setQuietFloor(double floor) noexcept {
   for (StringVoice& s : strings_) s.setQuietFloor(floor);
   quiet_.setFloor(floor < 0.0 ? floor : floor * static_cast<double>(strings_.size()));

@@ -26,6 +26,7 @@ class UnisonStrings {
   void noteOn(double velocity, bool unaCorda = false) noexcept;
   void release(double damperScale, double contact) noexcept;
   void setBend(double semitones) noexcept;
+  void setLiveTail(bool on) noexcept;         // each string's (StringVoice::setLiveTail)
   void setQuietFloor(double floor) noexcept;  // each string's: the caller shares it among them
 
   // Writes (not adds) the key's next left.size() samples (at most maxBlock; right as long): the

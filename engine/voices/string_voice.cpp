@@ -325,7 +325,8 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
                                          }) + why);
   }
   string.setLossWeights(schemeSide.weights);
-  require(std::isfinite(patch.linearBelow) && patch.linearBelow >= 0.0 && patch.linearBelow <= 1e-3,
+  require(std::isfinite(patch.linearBelow) && patch.linearBelow >= 0.0 &&
+              patch.linearBelow <= kMaxLinearBelow,
           "linear_below", patch.linearBelow,
           "between 0 (never linear) and 1e-3 (a relative tension change; the pitch is then off by "
           "at most 866 × it cents)");
@@ -525,10 +526,14 @@ void StringVoice::checkLinear() noexcept {
   const double beta = string.tensionScale();
   const double modulation =
       p.young * p.area * energy() / (beta * beta * p.tension * p.tension * p.length);
-  if (!linear_ && parked_ && modulation < patch_.linearBelow)
+  const double below =
+      liveTail_ ? std::max(patch_.linearBelow, kMaxLinearBelow) : patch_.linearBelow;
+  if (!linear_ && parked_ && modulation < below) {
     setLinear(true);
-  else if (linear_ && modulation > 2.0 * patch_.linearBelow)
+    linearAt_ = below;
+  } else if (linear_ && modulation > 2.0 * linearAt_) {
     setLinear(false);
+  }
 }
 
 void StringVoice::setLinear(bool on) noexcept {

@@ -61,6 +61,9 @@ struct StringPatch {
 
 // loss.damper_t60_s's largest value: the preset's "no damper" (the keys from F6 up).
 constexpr double kNoDamperT60 = 1000.0;  // s
+// linear_below's largest value: a relative tension change that puts the pitch off by at most
+// 866 × it cents, 0.87.
+constexpr double kMaxLinearBelow = 1e-3;
 // The most a string is detuned from its note, cents: its unison spread and its bridge's load.
 constexpr double kMaxDetuneCents = 50.0;
 
@@ -118,6 +121,12 @@ class StringVoice {
   // Bends the pitch by `semitones` (clamped to ±bendRange) by retensioning the transverse wave:
   // β T0 is solved in closed form so the scheme's fundamental moves by exactly that interval.
   void setBend(double semitones) noexcept;
+  // The live tail (the player under load, Synth::setLiveTail): the linear tail taken from a
+  // tension modulation of kMaxLinearBelow (the pitch then off by at most 0.87 cents) where the
+  // preset sets less, so that decaying strings step the linear string sooner, at about half the
+  // cost. A preset without the tail (linear_below 0) keeps none. A string gone linear stays so
+  // when it ends (until struck, or over twice the threshold it went linear at).
+  void setLiveTail(bool on) noexcept { liveTail_ = on; }
   // Where the voice counts as silent and frees itself (QuietDetector::setFloor): in its output
   // units, negative for never. The default, QuietDetector::kFloor, is −100 dB under unit output.
   void setQuietFloor(double floor) noexcept { quiet_.setFloor(floor); }
@@ -198,6 +207,8 @@ class StringVoice {
   bool active_ = false, struck_ = false;
   bool parked_ = true;  // the back-check holds the hammer (until the next strike)
   bool linearisable_ = false, linear_ = false, steppedLinear_ = false;
+  bool liveTail_ = false;
+  double linearAt_ = 0.0;  // the threshold in effect when the string last went linear
 };
 
 }  // namespace hamiltone

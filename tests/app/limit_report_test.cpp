@@ -54,6 +54,21 @@ TEST(LimitReport, OnJackTheBufferIsTheServersPeriod) {
   EXPECT_THAT(line, ::testing::Not(HasSubstr("--threads")));  // every core is used already
 }
 
+// The live tail, the step before any drop, is said once: its first turn on, not each one after.
+TEST(LimitReport, SaysOnceThatTheTailsWentLive) {
+  LimitReport report(context());
+  Player::Status s;
+  s.limit = 16;
+  s.liveTail = true;
+  s.liveTails = 1;
+  EXPECT_THAT(report.update(s, 1.0),
+              HasSubstr("live tails on: the audio callback took over 60% of its period"));
+  EXPECT_EQ(report.update(s, 2.0), "");
+  s.liveTails = 3;
+  EXPECT_EQ(report.update(s, 20.0), "");
+  EXPECT_THAT(report.update(dropped(1, 15, 0.9), 21.0), HasSubstr("lowered to 15 of 16"));
+}
+
 // Drops in quick succession: one line, then the ones since, kInterval later, counted.
 TEST(LimitReport, IsRateLimitedAndCountsTheDropsBetweenLines) {
   LimitReport report(context());

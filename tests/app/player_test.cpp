@@ -264,8 +264,9 @@ TEST(Player, KnowsTheThreadOfItsCallback) {
 constexpr double kNoBudget = 1e-9;
 
 // Overloaded block after block with 8 keys sounding: nothing on the first block (a single late
-// block, as a busy server gives, is no overload), then one key at a time, kHoldSeconds apart (the
-// key fading out is measured gone first), down to the floor of kFloorVoices and no further.
+// block, as a busy server gives, is no overload), then the strings' live tail and one key at a
+// time, kHoldSeconds apart (the key fading out is measured gone first), down to the floor of
+// kFloorVoices and no further.
 TEST(Player, OverloadLowersTheVoiceLimitOneKeyPerHoldDownToTheFloor) {
   constexpr int kFrames = 64, kPolyphony = 8;
   const double hold = Player::kHoldSeconds * kRate / kFrames;  // blocks
@@ -295,6 +296,10 @@ TEST(Player, OverloadLowersTheVoiceLimitOneKeyPerHoldDownToTheFloor) {
         limit = status.limit;
       }
       EXPECT_EQ(status.limitDrops, static_cast<long>(dropsAt.size()));
+      // The live tail, at kTailShare of the budget, goes on with the first drop, once.
+      EXPECT_EQ(status.liveTail, block >= Player::kOverloadedBlocks - 1) << "block " << block;
+      EXPECT_EQ(synth.liveTail(), status.liveTail);
+      EXPECT_EQ(status.liveTails, status.liveTail ? 1 : 0);
     }
     EXPECT_EQ(limit, Player::kFloorVoices);
     ASSERT_EQ(dropsAt.size(), size_t{kPolyphony - Player::kFloorVoices});
@@ -336,6 +341,8 @@ TEST(Player, UnderLightLoadTheLimitStaysAtThePresetsPolyphony) {
       const Player::Status status = player.status();
       EXPECT_LT(status.load, Player::kRelief);
       EXPECT_EQ(status.limit, kPolyphony);
+      EXPECT_FALSE(status.liveTail);
+      EXPECT_FALSE(synth.liveTail());
       EXPECT_EQ(synth.polyphony(), kPolyphony);
       EXPECT_EQ(status.voices, synth.activeVoices());
       EXPECT_EQ(status.guardEvents, synth.guardEvents());

@@ -163,6 +163,42 @@ TEST(LinearTail, AStrikeMakesTheStringGeometricAgain) {
   EXPECT_NEAR(ga / gb, 1.0, 0.02);
 }
 
+// The live tail (a player under load): a string whose preset says 1e-4 goes linear where one whose
+// preset says 1e-3 (kMaxLinearBelow) does, to the bit; turned off once it is linear, it stays
+// linear, still to the bit; turned off before, the string goes on as its preset's.
+TEST(LinearTail, TheLiveTailTakesTheLargestThresholdAndLeavesALinearStringSo) {
+  StringVoice live, atBound, preset, liveOffEarly;
+  live.prepare(piano(48, 1e-4), 48, kRate);
+  atBound.prepare(piano(48, kMaxLinearBelow), 48, kRate);
+  preset.prepare(piano(48, 1e-4), 48, kRate);
+  liveOffEarly.prepare(piano(48, 1e-4), 48, kRate);
+  live.setLiveTail(true);
+  liveOffEarly.setLiveTail(true);
+  for (StringVoice* v : {&live, &atBound, &preset, &liveOffEarly}) v->noteOn(0.2);
+  std::vector<double> a, b, c, d;
+  int block = 0;
+  for (; block < 3 * 750 && !live.linear(); ++block) {
+    if (block == 10) liveOffEarly.setLiveTail(false);
+    play(live, 64.0 / kRate, a);
+    play(atBound, 64.0 / kRate, b);
+    play(preset, 64.0 / kRate, c);
+    play(liveOffEarly, 64.0 / kRate, d);
+  }
+  ASSERT_TRUE(live.linear());
+  EXPECT_TRUE(atBound.linear());
+  EXPECT_FALSE(preset.linear());
+  std::printf("C3 v0.2: linear at %.2f s with the live tail\n", block * 64.0 / kRate);
+  live.setLiveTail(false);
+  play(live, 0.5, a);
+  play(atBound, 0.5, b);
+  play(preset, 0.5, c);
+  play(liveOffEarly, 0.5, d);
+  EXPECT_TRUE(live.linear());
+  EXPECT_EQ(a, b);
+  EXPECT_EQ(c, d);
+  EXPECT_NE(a, c);
+}
+
 // The end tension a bridge reads after a step (UnisonStrings) is the step's own: the geometric
 // string's from its ∇V' at qⁿ, or the linear string's EA η_M at qⁿ — also at the step after which
 // the string went back (here a bend an octave down while linear: β ≈ 1/4 raises the bound 16-fold
