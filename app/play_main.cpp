@@ -363,7 +363,8 @@ int play(const PlayArguments& a) {
                  "\r  voices %2d/%-3d  cpu %3.0f%% (peak %3.0f%%)  underruns %ld (late %ld)  "
                  "midi %-12s  guard %d%s%s   ",
                  s.voices, s.limit, 100.0 * s.load, 100.0 * s.peakLoad, audio.underruns(), s.late,
-                 describe(s.lastMessage).c_str(), s.guardEvents, s.liveTail ? "  live tails" : "",
+                 describe(s.lastMessage).c_str(), s.guardEvents,
+                 s.liveTail ? "  live tails" : "            ",
                  recordingFailureShown ? "  REC STOPPED" : "");
     std::fflush(stderr);
   }

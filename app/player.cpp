@@ -134,9 +134,9 @@ void Player::render(float* interleaved, int frames, std::int64_t nowNs) noexcept
 // since a key fading out (5 ms) is no longer counted but still costs its time — and then it came
 // back a key per second at best.
 void Player::protect(double load, double blockSeconds) noexcept {
-  protectTails(load, blockSeconds);
   const int floor = std::min(fullLimit_, kFloorVoices);
   holdTime_ = std::max(0.0, holdTime_ - blockSeconds);
+  protectTails(load, blockSeconds);
   if (load > overload_) {
     reliefTime_ = 0.0;
     runPeak_ = overloadedRun_ == 0 ? load : std::max(runPeak_, load);
@@ -166,16 +166,21 @@ void Player::protect(double load, double blockSeconds) noexcept {
 }
 
 // The first step, at kTailShare of the budget: the strings' live tail, which costs no key and
-// moves a decaying string's pitch by under a cent. Off again only after kTailRelief seconds of
-// light load, since turning it off raises the load it lowered.
+// moves a decaying string's pitch by under a cent; a key may go only kHoldSeconds after it, once
+// its effect is measured (strings under the new threshold go linear within 256 steps). Only with
+// keys sounding and an instrument whose strings take it (Synth::takesLiveTail). Off again only
+// after kTailRelief seconds of light load, since turning it off raises the load it lowered.
 void Player::protectTails(double load, double blockSeconds) noexcept {
   const bool on = liveTail_.load(std::memory_order_relaxed);
   if (load > kTailShare * overload_) {
     tailReliefTime_ = 0.0;
-    if (++tailRun_ >= kOverloadedBlocks && !on) {
+    tailRun_ = std::min(tailRun_ + 1, kOverloadedBlocks);
+    if (tailRun_ >= kOverloadedBlocks && !on && synth_.takesLiveTail() &&
+        synth_.activeVoices() > 0) {
       synth_.setLiveTail(true);
       liveTail_.store(true, std::memory_order_relaxed);
       liveTails_.fetch_add(1, std::memory_order_relaxed);
+      holdTime_ = kHoldSeconds;  // its effect measured before a key may go
     }
     return;
   }

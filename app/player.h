@@ -33,9 +33,11 @@ class Player {
   static constexpr double kHoldSeconds = 0.05;
   static constexpr int kFloorVoices = 4;
   // Before a key is dropped, the tails (Synth::setLiveTail): kOverloadedBlocks blocks in a row
-  // over kTailShare of the budget (0.6 of the period by default) let the decaying strings go
-  // linear sooner, at about half their cost, their pitch off by at most 0.87 cents; kTailRelief
-  // seconds in a row under kRelief give the strings not yet linear their preset's tail again.
+  // over kTailShare of the budget (0.6 of the period by default), with keys sounding, let the
+  // decaying strings go linear sooner, at about half their cost, their pitch off by at most 0.87
+  // cents, and hold any drop for kHoldSeconds; kTailRelief seconds in a row under kRelief give the
+  // strings not yet linear their preset's tail again. A new Player takes the synth's tail as off:
+  // one synth reused by several players must be set off between them.
   static constexpr double kTailShare = 0.75;
   static constexpr double kTailRelief = 2.0;
 
@@ -49,7 +51,8 @@ class Player {
   // An empty score is played to its end at once (status().finished once no key sounds).
   // `endRecording`: the recording ends with the block in which the score finished (the player
   // then exits), so that it is the same in every run at the same block size, rather than going
-  // on for however long the main thread takes to notice.
+  // on for however long the main thread takes to notice — as long as the load never called for
+  // the overload protection (its live tail and voice limit change what plays).
   void setScore(std::span<const TimedMessage> score, bool endRecording = false);
 
   // Fills `frames` interleaved stereo frames. A message that arrived a time d before `nowNs`

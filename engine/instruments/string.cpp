@@ -306,7 +306,9 @@ void NonlinearString::cellStrains(const Vector& q, double* strain, double* inver
 
 // One coarse cell (Mv = 1: the strings shorter than 2.1 √(E/ρ) k, the Kirchhoff–Carrier limit of
 // SCHEMES §3b): v has no unknowns, so η = 0, S = sqrt(1 + Z) with Z = (1/M) Σ_l ζ_l² the mean
-// square slope of the whole string, read from u in place (ζ_0 = u_0/h, ζ_{M−1} = −u_{M−2}/h).
+// square slope of the whole string, read from u in place (ζ of the end segments u_1/h and
+// −u_{M−1}/h). Its sum's order is the compiler's (`omp simd`): the same on every kernel path of
+// a build.
 NonlinearString::OneCell NonlinearString::oneCell(const Vector& q) const {
   const Eigen::Index m = segments_;
   const double* u = q.data();
@@ -324,8 +326,8 @@ NonlinearString::OneCell NonlinearString::oneCell(const Vector& q) const {
 }
 
 // Its gradient, the two grids' with r = M and η = 0: ∂V'/∂ζ_l = c (ε/S) ζ_l, so
-// ∇_u V' = D₋ᵀ(c (ε/S) ζ) = c (ε/S) (2u_j − u_{j−1} − u_{j+1}) / h², one sweep where the cells'
-// kernels take four and a copy; the tension at the end, c M ε/(S h_v).
+// ∇_u V' = D₋ᵀ(c (ε/S) ζ) = c (ε/S) (2u_j − u_{j−1} − u_{j+1}) / h²: with oneCell's, two sweeps
+// where the cells' kernels take four and a copy; the tension at the end, c M ε/(S h_v).
 double NonlinearString::oneCellGradient(const Vector& q, Vector& grad) const {
   const Eigen::Index m = segments_;
   const double* u = q.data();

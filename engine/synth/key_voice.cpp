@@ -93,6 +93,11 @@ void KeyVoice::setLiveTail(bool on) noexcept {
   if (UnisonStrings* strings = std::get_if<UnisonStrings>(&voice_)) strings->setLiveTail(on);
 }
 
+bool KeyVoice::takesLiveTail() const {
+  const UnisonStrings* strings = std::get_if<UnisonStrings>(&voice_);
+  return strings && strings->takesLiveTail();
+}
+
 double KeyVoice::level() const {
   if (sinceStrike_ < attackSamples_) return 1.0;
   return loudest_ > 0.0 ? envelope_ / loudest_ : 0.0;

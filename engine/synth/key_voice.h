@@ -39,6 +39,7 @@ class KeyVoice {
   void fadeOut() noexcept;  // stolen or silenced: fades over kFadeS, then frees itself
   void setBend(double semitones) noexcept;
   void setLiveTail(bool on) noexcept;  // a string key's (UnisonStrings::setLiveTail); a plate: none
+  bool takesLiveTail() const;
 
   // Writes the key's next `frames` samples (at most maxBlock), times `gain`, into its own output
   // (left(), right()): the synthesizer sums the keys' outputs in a fixed order, so the mix does not

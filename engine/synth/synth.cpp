@@ -94,6 +94,9 @@ void Synth::prepare(std::vector<Instrument> instruments, const SynthSetup& setup
   std::fill(std::begin(downProgram_), std::end(downProgram_), -1);
   contact_ = 1.0;
   sostenuto_ = unaCorda_ = liveTail_ = false;
+  takesLiveTail_.assign(instruments_.size(), 0);
+  for (size_t p = 0; p < voices_.size(); ++p)
+    for (const KeyVoice& v : voices_[p]) takesLiveTail_[p] = takesLiveTail_[p] || v.takesLiveTail();
   bend_ = 0.0;
   strikes_ = steals_ = 0;
   loudestSteal_ = 0.0;

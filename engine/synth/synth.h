@@ -89,6 +89,9 @@ class Synth {
   // strings not yet linear go on to the preset's threshold, the linear ones stay linear.
   void setLiveTail(bool on) noexcept;
   bool liveTail() const { return liveTail_; }
+  // The instrument playing now has strings whose tail the live tail moves (not a plate, nor a
+  // preset with linear_below 0 or at the bound already, nor the transverse grid).
+  bool takesLiveTail() const { return takesLiveTail_[program_] != 0; }
   // How a note-off's release velocity scales its damper's T60: 2^((64 − v)/63) — a key let go
   // fast (127) damps in half the time, a slow one (1) in twice, 64 as the preset says; 0 (no
   // velocity given, or a note-on at velocity 0) is 1.
@@ -179,6 +182,7 @@ class Synth {
   int downProgram_[128];  // which instrument's voice a held note struck (−1: none)
   bool sostenuto_ = false, unaCorda_ = false;
   bool liveTail_ = false;
+  std::vector<char> takesLiveTail_;  // per instrument (takesLiveTail())
   double contact_ = 1.0;  // of the dampers of the keys released under the pedal (damperContact)
   double bend_ = 0.0;     // −1 … 1 of the range
   double damperScale_ = 1.0;

@@ -64,6 +64,12 @@ void UnisonStrings::setLiveTail(bool on) noexcept {
   for (StringVoice& s : strings_) s.setLiveTail(on);
 }
 
+bool UnisonStrings::takesLiveTail() const {
+  for (const StringVoice& s : strings_)
+    if (s.takesLiveTail()) return true;
+  return false;
+}
+
 void UnisonStrings::setQuietFloor(double floor) noexcept {
   for (StringVoice& s : strings_) s.setQuietFloor(floor);
   quiet_.setFloor(floor < 0.0 ? floor : floor * static_cast<double>(strings_.size()));

@@ -515,9 +515,10 @@ double StringVoice::pickup(const Vector& q, const Vector& qNext, const PickupTap
 // slope, raises the pitch by ΔT/βT0 of the bent tension, and is bounded at every instant by the
 // energy: H >= ½ βT0 L Z̄ (the rest of H — kinetic, bending, v, the hammer parked at rest — is
 // >= 0), so ΔT/βT0 <= EA H / (β² T0² L). Once the hammer is parked and that bound has fallen under
-// linearBelow, V' is dropped for its quadratic part at rest (NonlinearString::setLinearised), and
-// a step is Störmer–Verlet on the linear string, one pass; over twice linearBelow again (energy
-// the bridge brings from a sibling string, or a bend down) it is geometric again. Each switch
+// linearBelow (kMaxLinearBelow, if larger, under the live tail), V' is dropped for its quadratic
+// part at rest (NonlinearString::setLinearised), and a step is Störmer–Verlet on the linear string,
+// one pass; over twice the threshold it went linear at (energy the bridge brings from a sibling
+// string, or a bend down) it is geometric again. Each switch
 // changes the energy by what ψ held less the quadratic part, counted with what the strikes put
 // in. Checked at fixed step counts, so the output does not depend on the block size.
 void StringVoice::checkLinear() noexcept {

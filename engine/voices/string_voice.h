@@ -127,6 +127,8 @@ class StringVoice {
   // cost. A preset without the tail (linear_below 0) keeps none. A string gone linear stays so
   // when it ends (until struck, or over twice the threshold it went linear at).
   void setLiveTail(bool on) noexcept { liveTail_ = on; }
+  // The live tail changes something: the string takes the linear tail, below kMaxLinearBelow.
+  bool takesLiveTail() const { return linearisable_ && patch_.linearBelow < kMaxLinearBelow; }
   // Where the voice counts as silent and frees itself (QuietDetector::setFloor): in its output
   // units, negative for never. The default, QuietDetector::kFloor, is −100 dB under unit output.
   void setQuietFloor(double floor) noexcept { quiet_.setFloor(floor); }
@@ -157,7 +159,7 @@ class StringVoice {
   }
 
   bool active() const { return active_; }
-  bool linear() const { return linear_; }  // in its linear tail (linearBelow)
+  bool linear() const { return linear_; }  // in its linear tail (linearBelow, or the live tail's)
   double energy() const;                   // the scheme's H^{n+½} (ε excluded), J
   // By the strikes, the bend's retensioning and the linear tail's switches (what ψ held against
   // V''s quadratic part at rest, either sign).

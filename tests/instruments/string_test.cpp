@@ -46,10 +46,11 @@ Eigen::MatrixXd matrixOf(const NonlinearString& s, auto apply) {
 
 // Random states of a few mm transverse and a few µm longitudinal, like a struck piano string;
 // a relative 1e-6 against central differences leaves room for O(δ²) and for roundoff ~ 1e-16 V'/δ.
-// On the single grid of (65), on nested grids of 5 and 8 fine segments per cell, and on one cell.
+// On the single grid of (65), on nested grids of 5 and 8 fine segments per cell, and on one cell
+// (of 40, 3 and 2 segments: the in-place sweeps of oneCell with their ends).
 TEST(NonlinearString, GradientIsTheDerivativeOfTheSplitPotential) {
-  for (const StringGrid grid :
-       {StringGrid{40, 40}, StringGrid{40, 8}, StringGrid{40, 5}, StringGrid{40, 1}}) {
+  for (const StringGrid grid : {StringGrid{40, 40}, StringGrid{40, 8}, StringGrid{40, 5},
+                                StringGrid{40, 1}, StringGrid{2, 1}, StringGrid{3, 1}}) {
     const NonlinearString string(c3(), grid);
     const Eigen::Index n = string.size(), nu = string.transverseSize();
     Vector grad(n);

@@ -58,6 +58,7 @@ int main() {
       synth.prepare(instruments, setup);
       for (int frames : {1, 64, 256, 1024}) {
         synth.setPolyphony(0);  // undo what an earlier run's overload protection lowered
+        synth.setLiveTail(false);
         SpscQueue<app::StampedMessage> midi(256);
         SpscQueue<float> record(2 * static_cast<size_t>(rate));
         app::Player player(synth, midi, &record, rate, frames);

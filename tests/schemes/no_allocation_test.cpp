@@ -301,6 +301,7 @@ TEST(NoAllocation, PlayerRender) {
     for (int frames : {1, 64, 256, 1024}) {
       SCOPED_TRACE(::testing::Message() << rate << " Hz, " << frames << " frames");
       synth.setPolyphony(0);
+      synth.setLiveTail(false);
       SpscQueue<app::StampedMessage> midi(256);
       SpscQueue<float> record(2 * static_cast<size_t>(rate));
       app::Player player(synth, midi, &record, rate, frames);

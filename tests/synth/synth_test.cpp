@@ -31,6 +31,23 @@ using testing::Take;
 
 constexpr double kRate = testing::kTakeRate;
 
+// The live tail moves something only where strings take the linear tail below its bound: the
+// piano keys (linear_below 1e-4 by default); not a plate, nor keys whose preset says 0 (never
+// linear) or already 1e-3. It follows the instrument a program change chooses.
+TEST(Synth, TakesTheLiveTailOnlyWhereAStringsTailWouldMove) {
+  Instrument never = pianoKeys(60, 61), atBound = pianoKeys(60, 61);
+  for (StringKey& key : never.keys) key.patch.linearBelow = 0.0;
+  for (StringKey& key : atBound.keys) key.patch.linearBelow = kMaxLinearBelow;
+  Synth synth = prepared({pianoKeys(60, 61), smallPlate(), never, atBound});
+  EXPECT_TRUE(synth.takesLiveTail());
+  for (int program : {1, 2, 3}) {
+    synth.handle({0xC0, static_cast<uint8_t>(program), 0});
+    EXPECT_FALSE(synth.takesLiveTail()) << "program " << program;
+  }
+  synth.handle({0xC0, 0, 0});
+  EXPECT_TRUE(synth.takesLiveTail());
+}
+
 TEST(Synth, SustainHoldsReleasedNotesUntilThePedalLifts) {
   Synth synth = prepared({pianoKeys(48, 50)});
   render(synth, {{0.0, cc(64, 127)}, {0.0, on(48)}, {0.1, off(48)}}, 0.5, 256);

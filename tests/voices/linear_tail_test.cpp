@@ -197,6 +197,17 @@ TEST(LinearTail, TheLiveTailTakesTheLargestThresholdAndLeavesALinearStringSo) {
   EXPECT_EQ(a, b);
   EXPECT_EQ(c, d);
   EXPECT_NE(a, c);
+  // A preset without the tail (0: the research presets') keeps none under the live tail.
+  StringVoice never;
+  never.prepare(piano(48, 0.0), 48, kRate);
+  never.setLiveTail(true);
+  never.noteOn(0.2);
+  bool ever = false;
+  std::vector<double> e;
+  play(never, block * 64.0 / kRate + 0.5, e, 64, [&] { ever = ever || never.linear(); });
+  EXPECT_FALSE(ever);
+  EXPECT_FALSE(never.takesLiveTail());
+  EXPECT_TRUE(live.takesLiveTail());
 }
 
 // The end tension a bridge reads after a step (UnisonStrings) is the step's own: the geometric
