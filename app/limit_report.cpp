@@ -10,7 +10,7 @@ std::string LimitReport::update(const Player::Status& status, double seconds) {
   if (status.liveTails > 0 && !tailsSaid_) {
     tailsSaid_ = true;
     std::snprintf(line, sizeof line,
-                  "live tails on: the audio callback took over %.0f%% of its period, so decaying "
+                  "live tails on: the audio callback took over %g%% of its period, so decaying "
                   "strings now go linear sooner (pitch moved by under a cent) before any voice "
                   "is dropped",
                   100.0 * Player::kTailShare * context_.budget);
