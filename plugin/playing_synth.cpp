@@ -28,7 +28,8 @@ void PlayingSynth::setControls(const Controls& asked) noexcept {
   const Controls controls{.gainDb = kGainDbRange.held(asked.gainDb),
                           .velocityCurve = kVelocityCurveRange.held(asked.velocityCurve),
                           .damperScale = kDamperScaleRange.held(asked.damperScale),
-                          .polyphony = static_cast<int>(kPolyphonyRange.held(asked.polyphony))};
+                          .polyphony = static_cast<int>(kPolyphonyRange.held(asked.polyphony)),
+                          .lightTails = asked.lightTails};
   const bool first = !controlsSet_;
   controlsSet_ = true;
   if (controls == controls_ && !first) return;
@@ -42,6 +43,7 @@ void PlayingSynth::applyControls() noexcept {
   if (!current_) return;
   current_->synth.setDamperScale(controls_.damperScale);
   current_->synth.setPolyphony(controls_.polyphony);
+  current_->synth.setLiveTail(controls_.lightTails);
 }
 
 // One swap at a time: a newer synthesizer waits in the loader's slot while one fades.

@@ -28,6 +28,7 @@ struct Controls {
   double velocityCurve = 1.0;  // note-on velocity v becomes 127·(v/127)^curve: > 1 plays softer
   double damperScale = 1.0;    // Synth::setDamperScale
   int polyphony = 0;           // Synth::setPolyphony; 0: the preset's
+  bool lightTails = false;     // Synth::setLiveTail: the strings' tails linear from 1e-3
   bool operator==(const Controls&) const = default;
 };
 
@@ -77,8 +78,10 @@ class PlayingSynth {
   void process(std::span<float> left, std::span<float> right,
                std::span<const Midi> midi) noexcept HAMILTONE_PLUGIN_NONBLOCKING;
 
-  // The recipe of the synthesizer playing, or nullptr before the first (for tests).
+  // The recipe of the synthesizer playing, and that synthesizer, or nullptr before the first (for
+  // tests).
   const SynthRecipe* playing() const { return current_ ? &current_->recipe : nullptr; }
+  const Synth* synth() const { return current_ ? &current_->synth : nullptr; }
 
  private:
   template <class Midi>

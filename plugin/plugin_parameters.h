@@ -11,6 +11,7 @@ enum Parameter : unsigned {
   kDamperScale,    // 0.25 … 4, Controls::damperScale
   kPolyphony,      // 0 … 64; 0: the preset's
   kStatus,         // output: LoadStatus (0 loading, 1 ready, 2 failed)
+  kLightTails,     // 0 or 1, Controls::lightTails (last, so that older sessions keep their ids)
   kParameterCount
 };
 

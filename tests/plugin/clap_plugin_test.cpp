@@ -138,7 +138,8 @@ TEST(ClapPlugin, DescribesAnInstrumentWithMidiInStereoOutAndNoLatency) {
   const auto* params = plugin.extension<clap_plugin_params_t>(CLAP_EXT_PARAMS);
   ASSERT_NE(params, nullptr);
   ASSERT_EQ(params->count(&plugin.plugin()), unsigned(kParameterCount));
-  const char* names[] = {"Preset", "Gain", "Velocity curve", "Damper decay", "Polyphony", "Status"};
+  const char* names[] = {"Preset",    "Gain",   "Velocity curve", "Damper decay",
+                         "Polyphony", "Status", "Light tails"};
   for (unsigned i = 0; i < kParameterCount; ++i) {
     clap_param_info_t info{};
     ASSERT_TRUE(params->get_info(&plugin.plugin(), i, &info));

@@ -169,6 +169,26 @@ TEST_F(PlayingSynthTest, ASwapKeepsThePedalAndTheVolume) {
   EXPECT_NEAR(swapped.peak(7200), referenceTail, 0.02f * referenceTail);
 }
 
+// The Light tails switch reaches the synthesizer playing, and the next one a swap adopts; off
+// again, both are off. A host's value is the control's (Synth::setLiveTail).
+TEST_F(PlayingSynthTest, LightTailsReachTheSynthesizerAndSurviveASwap) {
+  play(playing_, 256);
+  ASSERT_NE(playing_.synth(), nullptr);
+  EXPECT_FALSE(playing_.synth()->liveTail());
+  playing_.setControls({.lightTails = true});
+  play(playing_, 256);
+  EXPECT_TRUE(playing_.synth()->liveTail());
+  EXPECT_TRUE(playing_.synth()->takesLiveTail());  // the grand piano's strings
+  loader_.setBundled(6);
+  awaitLoader(loader_);
+  play(playing_, 4800);  // the swap, and its fade
+  EXPECT_EQ(playing_.playing()->bundled, 6);
+  EXPECT_TRUE(playing_.synth()->liveTail());
+  playing_.setControls({});
+  play(playing_, 256);
+  EXPECT_FALSE(playing_.synth()->liveTail());
+}
+
 // A host's sample rate of NaN or ±inf builds no synthesizer; the output is silence, not NaN (it
 // was NaN for good: the gain's smoothing took the rate).
 TEST(PlayingSynth, ARateNoSynthesizerBuildsAtGivesSilence) {
