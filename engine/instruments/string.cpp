@@ -345,21 +345,24 @@ double NonlinearString::oneCellGradient(const Vector& q, Vector& grad) const {
     for (Eigen::Index j = 1; j < m - 2; ++j) gu[j] = f * (2.0 * u[j] - u[j - 1] - u[j + 1]);
   }
   endTension_ = weight * static_cast<double>(m) / hv_;
-  return 0.5 * hv_ * (physics_.young * physics_.area - physics_.tension) * cell.strain *
-         cell.strain;
+  return cellsPotential(cell.strain * cell.strain);
 }
 
-// V' = (EA − T0)/2 Σ_J h_v ε_J².
+// V' = (EA − T0)/2 Σ_J h_v ε_J², from Σ_J ε_J².
+double NonlinearString::cellsPotential(double squaredStrains) const {
+  return 0.5 * hv_ * (physics_.young * physics_.area - physics_.tension) * squaredStrains;
+}
+
 double NonlinearString::twoGridPotential(const Vector& q) const {
   if (grid_.longitudinal == 1) {
     const double strain = oneCell(q).strain;
-    return 0.5 * hv_ * (physics_.young * physics_.area - physics_.tension) * strain * strain;
+    return cellsPotential(strain * strain);
   }
   double* strain = cell2_.data();
   cellStrains(q, strain, cell3_.data(), work1_.data());
   double sum = 0.0;
   for (Eigen::Index j = 0; j < grid_.longitudinal; ++j) sum += strain[j] * strain[j];
-  return 0.5 * hv_ * (physics_.young * physics_.area - physics_.tension) * sum;
+  return cellsPotential(sum);
 }
 
 // With c = (EA − T0) h_u, ∂ε_J/∂ζ_l = ζ_l/(r S_J) and ∂ε_J/∂η_J = (1 + η_J)/S_J:
@@ -387,7 +390,7 @@ double NonlinearString::twoGridGradient(const Vector& q, Vector& grad) const {
   const double invHv = 1.0 / hv_;
   for (Eigen::Index j = 0; j < mv - 1; ++j) gv[j] = (we[j] - we[j + 1]) * invHv;
   endTension_ = physics_.tension * eta[mv - 1] + we[mv - 1] * invHv;
-  return 0.5 * hv_ * (physics_.young * physics_.area - physics_.tension) * sum;
+  return cellsPotential(sum);
 }
 
 double minimalSpacing(const StringPhysics& p, GridRule rule, double k, double sigma1) {

@@ -134,6 +134,7 @@ class NonlinearString {
   double singleGridPotential(const Vector& q) const;
   double singleGridGradient(const Vector& q, Vector& grad) const;
   double twoGridPotential(const Vector& q) const;
+  double cellsPotential(double squaredStrains) const;  // V' of the two grids from Σ_J ε_J²
   double twoGridGradient(const Vector& q, Vector& grad) const;
   struct OneCell {
     double strain, stretch;  // ε = S − 1 and S of the string's one coarse cell
