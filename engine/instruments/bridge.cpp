@@ -21,12 +21,6 @@ BridgeCoupling::BridgeCoupling(const NonlinearString& string)
   self_ = tension + bending;
 }
 
-double BridgeCoupling::energy(const Vector& q, const Vector& qNext, double w, double wNext) const {
-  const double cq = c1_ * q[last_] + c2_ * q[second_];
-  const double cqNext = c1_ * qNext[last_] + c2_ * qNext[second_];
-  return 0.5 * (cqNext * w + cq * wNext) + 0.5 * self_ * wNext * w;
-}
-
 void Bridge::prepare(const BridgePhysics& p, double k, double addedStiffness) {
   auto require = [](bool ok, const char* field, double value, const std::string& valid) {
     if (!ok)

@@ -162,9 +162,7 @@ double NonlinearString::blockStableStep(double sigma1, double vTension) const {
 
 double NonlinearString::linearEndTension(const Vector& q) const {
   const int mv = grid_.longitudinal;
-  if (mv < 2) return 0.0;
-  const double etaLast = -q[segments_ - 1 + mv - 2] / hv_;  // v_M = 0
-  return physics_.young * physics_.area * etaLast;
+  return mv < 2 ? 0.0 : linearEndTension(q[segments_ - 1 + mv - 2]);  // η_M = −v_{Mv−1}/h_v
 }
 
 void NonlinearString::applyLossOperator(const Vector& a, const Vector& b, Vector& out) const {

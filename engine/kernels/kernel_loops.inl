@@ -224,6 +224,22 @@ HAMILTONE_TARGET void linearUpdate(long n, const double* q, const double* qm, co
   linearUpdateOf<false, false>(n, q, qm, minv, kq, x, xScale, down, kk, invUp, qp);
 }
 
+HAMILTONE_TARGET void modalStep(long n, const double* c1, const double* c2, const double* const* w,
+                                double f, double* older, const double* newer, double out[4]) {
+  const double *w0 = w[0], *w1 = w[1], *w2 = w[2], *w3 = w[3];
+  double p0 = 0.0, p1 = 0.0, p2 = 0.0, p3 = 0.0;
+#pragma omp simd reduction(+ : p0, p1, p2, p3)
+  for (long m = 0; m < n; ++m) {
+    const double x = c1[m] * newer[m] - c2[m] * older[m] + f * w2[m];
+    older[m] = x;
+    p0 += w0[m] * x;
+    p1 += w1[m] * x;
+    p2 += w2[m] * x;
+    p3 += w3[m] * x;
+  }
+  out[0] = p0, out[1] = p1, out[2] = p2, out[3] = p3;
+}
+
 // One vector register of doubles (GCC's vector extension, so that the product below is vectorised
 // along the rows as written, whatever the compiler's cost model).
 typedef double Lanes __attribute__((vector_size(kLanes * sizeof(double))));
@@ -304,6 +320,7 @@ extern const Kernels kernels{.isa = HAMILTONE_KERNEL_ISA,
                              .savDots = savDots,
                              .savUpdate = savUpdate,
                              .linearUpdate = linearUpdate,
+                             .modalStep = modalStep,
                              .matrixProduct = matrixProduct,
                              .gridLaplacian = gridLaplacian,
                              .gridCells = gridCells,

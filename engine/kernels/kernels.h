@@ -65,6 +65,13 @@ struct Kernels {
                        const double* kq, const double* x, double xScale, double down, double kk,
                        double invUp, double* qp);
 
+  // The modal tail's step (voices/modal_tail.h) over n modes: x_m = c1_m newer_m − c2_m older_m
+  // + f w[2]_m (w[2] the modal weights of the bridge's pull, along which its force acts, f that
+  // force scaled to a mode's step), written over older; out[p] = Σ_m w[p]_m x_m for the four
+  // probes.
+  void (*modalStep)(long n, const double* c1, const double* c2, const double* const* w, double f,
+                    double* older, const double* newer, double out[4]);
+
   // The plate's loops. C = A B, column-major, A m × k (leading dimension lda), B k × n read as
   // b_pj = b[stepB p + ldb j], C m × n; m a multiple of 8. Each c_ij is Σ_p a_ip b_pj summed in
   // order of p: the same bits on every path.

@@ -151,6 +151,18 @@ class SavScheme {
     prevKept_ = false;
   }
 
+  // Sets the state to q^n = q, q^{n+1} = qNext, `steps` steps on — a state stepped elsewhere (a
+  // string's linear tail in its modes, modal_tail.h), whose ψ_j the caller has kept consistent:
+  // the parts it leaves are slack or dropped. K q^n is taken again.
+  void setLevels(const Vector& q, const Vector& qNext, long steps) noexcept {
+    prev_ = q;
+    curr_ = qNext;
+    n_ += steps;
+    prevKept_ = false;
+    stiffnessChanged();
+  }
+  bool damped() const { return damped_; }  // a point damper holds a coordinate (setPointDamper)
+
   // After a change of K between steps (a string retensioned by the pitch bend): K q^n is taken
   // again, so energy() reports H of the new K on the same state. The difference is the work the
   // change did, which the next steps then conserve.

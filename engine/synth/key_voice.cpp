@@ -98,6 +98,11 @@ bool KeyVoice::takesLiveTail() const {
   return strings && strings->takesLiveTail();
 }
 
+int KeyVoice::stringsInModes() const {
+  const UnisonStrings* strings = std::get_if<UnisonStrings>(&voice_);
+  return strings ? strings->stringsInModes() : 0;
+}
+
 double KeyVoice::level() const {
   if (sinceStrike_ < attackSamples_) return 1.0;
   return loudest_ > 0.0 ? envelope_ / loudest_ : 0.0;

@@ -40,6 +40,7 @@ class KeyVoice {
   void setBend(double semitones) noexcept;
   void setLiveTail(bool on) noexcept;  // a string key's (UnisonStrings::setLiveTail); a plate: none
   bool takesLiveTail() const;
+  int stringsInModes() const;  // UnisonStrings'; a plate: 0
 
   // Writes the key's next `frames` samples (at most maxBlock), times `gain`, into its own output
   // (left(), right()): the synthesizer sums the keys' outputs in a fixed order, so the mix does not

@@ -142,6 +142,13 @@ int Synth::activeVoices() const {
   return count;
 }
 
+int Synth::stringsInModes() const {
+  int count = 0;
+  for (const auto& keys : voices_)
+    for (const KeyVoice& v : keys) count += v.stringsInModes();
+  return count;
+}
+
 bool Synth::silent() const {
   for (const auto& keys : voices_)
     for (const KeyVoice& v : keys)

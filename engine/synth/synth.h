@@ -98,6 +98,8 @@ class Synth {
   static double releaseScale(int velocity) noexcept;
   int polyphony() const;
   int activeVoices() const;
+  // The sounding strings that step their linear tail in their modes (StringVoice::inModes()).
+  int stringsInModes() const;
   // No key sounds, fades out or waits to be struck: what comes out now is the master bus's
   // DC-blocker tail at most. (activeVoices() does not count a key fading out.)
   bool silent() const;

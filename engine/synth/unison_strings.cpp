@@ -70,6 +70,12 @@ bool UnisonStrings::takesLiveTail() const {
   return false;
 }
 
+int UnisonStrings::stringsInModes() const {
+  int count = 0;
+  for (const StringVoice& s : strings_) count += s.active() && s.inModes();
+  return count;
+}
+
 void UnisonStrings::setQuietFloor(double floor) noexcept {
   for (StringVoice& s : strings_) s.setQuietFloor(floor);
   quiet_.setFloor(floor < 0.0 ? floor : floor * static_cast<double>(strings_.size()));
@@ -92,8 +98,7 @@ double UnisonStrings::energy() const {
   double e = 0.0;
   for (const StringVoice& s : strings_) {
     e += s.energy();
-    if (bridged_)
-      e += s.coupling().energy(s.scheme().q(), s.scheme().qNext(), wBefore_, bridge_.current());
+    if (bridged_) e += s.couplingEnergy(wBefore_, bridge_.current());
   }
   return bridged_ ? e + bridge_.energy() : e;
 }

@@ -28,6 +28,7 @@ class UnisonStrings {
   void setBend(double semitones) noexcept;
   void setLiveTail(bool on) noexcept;         // each string's (StringVoice::setLiveTail)
   bool takesLiveTail() const;                 // a string of the key does (StringVoice's)
+  int stringsInModes() const;                 // its strings stepping their modes (modal_tail.h)
   void setQuietFloor(double floor) noexcept;  // each string's: the caller shares it among them
 
   // Writes (not adds) the key's next left.size() samples (at most maxBlock; right as long): the

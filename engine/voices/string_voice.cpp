@@ -363,8 +363,32 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
     decimators_[c] = std::move(decimators[c]);
     taps_[c] = pickupTap(patch.pickups[c], segments());
   }
+  prepareModes();
   quiet_.prepare(sampleRate);
   reset();
+}
+
+// The modal tail's probes, each by its weights on u's nodes: the pickups' taps and the hammer's
+// contact (HammeredString::contactDisplacement, taken node by node); and the bridge's two nodes.
+void StringVoice::prepareModes() {
+  const HammeredString& system = scheme_->system();
+  const Eigen::Index nu = system.string().transverseSize();
+  std::array<std::vector<double>, ModalTail::kProbes> probes;
+  for (std::vector<double>& p : probes) p.assign(nu, 0.0);
+  for (int c = 0; c < 2; ++c) {
+    probes[ModalTail::kPickup0 + c][taps_[c].node] += taps_[c].weight;
+    probes[ModalTail::kPickup0 + c][taps_[c].next] += taps_[c].nextWeight;
+  }
+  const BridgeCoupling coupling(system.string());
+  Vector unit = Vector::Zero(system.size());
+  for (Eigen::Index j = 0; j < nu; ++j) {
+    unit[j] = 1.0;
+    probes[ModalTail::kContact][j] = system.contactDisplacement(unit);
+    unit[j] = 0.0;
+  }
+  modal_.prepare(system.string(), k_, probes, coupling.lastIndex(), coupling.secondIndex());
+  levelN_.setZero(system.size());
+  levelNext_.setZero(system.size());
 }
 
 void StringVoice::reset() noexcept {
@@ -373,8 +397,10 @@ void StringVoice::reset() noexcept {
   injected_ = caught_ = 0.0;
   separatedSteps_ = 0;
   quiet_.reset();
-  active_ = struck_ = linear_ = steppedLinear_ = false;  // the copy's string is geometric
+  active_ = struck_ = linear_ = steppedLinear_ = inModes_ = false;  // the copy is geometric
   parked_ = true;
+  steps_ = stepsInModes_ = 0;
+  bridgeAt_ = 0.0;
   applyBend();  // the copy brought back β = 1
 }
 
@@ -395,18 +421,29 @@ void StringVoice::applyBend() noexcept {
   scheme_->system().string().setTensionScale((root * root - bendOffset_) / bendSlope_);
   scheme_->stiffnessChanged();
   coupling_ = BridgeCoupling(scheme_->system().string());
+  modal_.setPull(coupling_.lastWeight(), coupling_.secondWeight());
+  if (inModes_) retuneModes();
   injected_ += energy() - before;
 }
 
 int StringVoice::segments() const { return scheme_->system().string().segments(); }
 
-double StringVoice::energy() const { return scheme_->energy().total(); }
+double StringVoice::energy() const {
+  return inModes_ ? modal_.energy() + besideModes_ : scheme_->energy().total();
+}
+
+double StringVoice::couplingEnergy(double w, double wNext) const noexcept {
+  if (!inModes_) return coupling_.energy(scheme_->q(), scheme_->qNext(), w, wNext);
+  using enum ModalTail::Probe;
+  return coupling_.energy(modal_.at(kPull), modal_.atNext(kPull), w, wNext);
+}
 
 void StringVoice::noteOn(double velocity) noexcept {
   // A freed voice starts from rest: what a decayed string keeps on the transverse grid (a static
   // longitudinal stretch the SAV can leave, see docs/string-grids.md) would detune the next note.
   if (!active_) reset();
-  if (linear_) setLinear(false);  // the strike's tension modulation, from its first step
+  if (linear_)
+    setLinear(false);  // the strike's tension modulation, from its first step (and nodes)
   const double v = velocity >= 0.0 ? std::min(velocity, 1.0) : 0.0;  // NaN too
   const double speed = patch_.velocityMin + (patch_.velocityMax - patch_.velocityMin) *
                                                 std::pow(v, patch_.velocityCurve);
@@ -433,6 +470,7 @@ void StringVoice::noteOn(double velocity) noexcept {
 void StringVoice::liftDamper() noexcept {
   scheme_->setSigma0(loss_.sigma0);
   for (int m = 0; m < feltNodes_; ++m) scheme_->setPointDamper(m, feltNode_[m], 0.0);
+  if (inModes_) retuneModes();
 }
 
 void StringVoice::wake() noexcept {
@@ -443,6 +481,7 @@ void StringVoice::wake() noexcept {
 }
 
 bool StringVoice::stepOnBridge(double w, double out[2]) noexcept {
+  bridgeAt_ = w;
   scheme_->setPointForce(0, coupling_.lastIndex(), coupling_.forceOnLast(w));
   scheme_->setPointForce(1, coupling_.secondIndex(), coupling_.forceOnSecond(w));
   if (!stepAndPick(out)) return false;
@@ -454,11 +493,13 @@ bool StringVoice::stepOnBridge(double w, double out[2]) noexcept {
 void StringVoice::release(double damperScale, double contact) noexcept {
   if (!patch_.feltDamper) {
     scheme_->setSigma0(releasedSigma0(loss_.sigma0, patch_.damperT60, damperScale, k_, contact));
+    if (inModes_) retuneModes();
     return;
   }
   // A NaN contact is the full damper, as releasedSigma0 takes it; r ∝ 1/T60 (D2).
   const double c = contact < 1.0 ? std::max(contact, 0.0) : 1.0;
   const double scale = damperScale > 0.0 ? damperScale : 1.0;
+  if (c > 0.0 && feltNodes_ > 0 && inModes_) leaveModes();  // dashpots on nodes: not modal
   for (int m = 0; m < feltNodes_; ++m) scheme_->setPointDamper(m, feltNode_[m], c * feltR_ / scale);
 }
 
@@ -520,7 +561,9 @@ double StringVoice::pickup(const Vector& q, const Vector& qNext, const PickupTap
 // one pass; over twice the threshold it went linear at (energy the bridge brings from a sibling
 // string, or a bend down) it is geometric again. Each switch
 // changes the energy by what ψ held less the quadratic part, counted with what the strikes put
-// in. Checked at fixed step counts, so the output does not depend on the block size.
+// in. Checked at fixed step counts, so the output does not depend on the block size. A linear
+// string with no damper on it then steps its modes, the highest of them dropped as they fall under
+// kModalFloor of its energy (what they held counted as removed).
 void StringVoice::checkLinear() noexcept {
   const NonlinearString& string = scheme_->system().string();
   const StringPhysics& p = string.physics();
@@ -535,9 +578,12 @@ void StringVoice::checkLinear() noexcept {
   } else if (linear_ && modulation > 2.0 * linearAt_) {
     setLinear(false);
   }
+  if (linear_ && !inModes_) enterModes();
+  if (inModes_) caught_ += modal_.truncate(modalFloor_);
 }
 
 void StringVoice::setLinear(bool on) noexcept {
+  if (!on && inModes_) leaveModes();
   const double before = energy();
   scheme_->system().string().setLinearised(on);
   if (on)
@@ -549,17 +595,82 @@ void StringVoice::setLinear(bool on) noexcept {
   linear_ = on;
 }
 
+void StringVoice::setModalTail(bool on, double floor) noexcept {
+  modalTail_ = on;
+  modalFloor_ = floor;
+  if (!on && inModes_) leaveModes();
+}
+
+// The modes' recursions for the string and σ0 as they are now (after a bend or a damper's move).
+void StringVoice::retuneModes() noexcept {
+  const StepParameters& p = scheme_->parameters();
+  modal_.setCoefficients(scheme_->system().string(), p.sigma0, p.sigma1);
+}
+
+// The scheme's ψ and its parked hammer stay as they are while the modes step: what they hold of
+// the energy is kept beside the modes' (with the transform's roundoff), so energy() goes on.
+void StringVoice::enterModes() noexcept {
+  if (!modalTail_ || !linear_ || scheme_->damped()) return;
+  const double before = energy();
+  retuneModes();
+  modal_.enter(scheme_->q(), scheme_->qNext());
+  besideModes_ = before - modal_.energy();
+  stepsInModes_ = 0;
+  inModes_ = true;
+}
+
+void StringVoice::leaveModes() noexcept {
+  const double before = energy();
+  levelN_ = scheme_->q();  // the same size: no allocation
+  levelNext_ = scheme_->qNext();
+  modal_.leave(levelN_, levelNext_);
+  scheme_->setLevels(levelN_, levelNext_, stepsInModes_);
+  inModes_ = false;
+  injected_ += energy() - before;
+}
+
+// The hammer stays parked while the modes step; should the string swing down onto it, the scheme
+// takes the string back at level n and the back-check meets the hammer as on the nodes.
+void StringVoice::stepModes() noexcept {
+  modal_.step(bridgeAt_);
+  ++stepsInModes_;
+  const double hammer = scheme_->q()[scheme_->system().hammerIndex()];
+  if (hammer - modal_.at(ModalTail::kContact) > 0.0) {
+    leaveModes();
+    catchHammer();
+  }
+}
+
 bool StringVoice::stepAndPick(double out[2]) noexcept {
   steppedLinear_ = linear_;
-  scheme_->step();
-  catchHammer();
-  if (linearisable_ && scheme_->stepIndex() % kLinearCheckSteps == 0) checkLinear();
-  const Vector& q = scheme_->q();
-  const Vector& qNext = scheme_->qNext();
+  if (inModes_) {
+    stepModes();
+  } else {
+    scheme_->step();
+    catchHammer();
+  }
   bool ready = false;
-  for (int c = 0; c < patch_.channels; ++c)
-    ready = decimators_[c].push(pickup(q, qNext, taps_[c]), out[c]);
+  for (int c = 0; c < patch_.channels; ++c) {
+    double value;
+    if (inModes_) {
+      const auto p = static_cast<ModalTail::Probe>(ModalTail::kPickup0 + c);
+      value = patch_.signal == PickupSignal::displacement ? modal_.at(p)
+                                                          : (modal_.atNext(p) - modal_.at(p)) / k_;
+    } else {
+      value = pickup(scheme_->q(), scheme_->qNext(), taps_[c]);
+    }
+    ready = decimators_[c].push(value, out[c]);
+  }
+  // After the pickups: the check changes what steps next, not this step's output.
+  ++steps_;
+  if (linearisable_ && steps_ % kLinearCheckSteps == 0) checkLinear();
   return ready;
+}
+
+std::pair<Vector, Vector> StringVoice::levels() const {
+  std::pair<Vector, Vector> x(scheme_->q(), scheme_->qNext());
+  if (inModes_) modal_.leave(x.first, x.second);
+  return x;
 }
 
 void StringVoice::process(std::span<float> left, std::span<float> right) noexcept {
@@ -583,8 +694,7 @@ void StringVoice::process(std::span<float> left, std::span<float> right) noexcep
     }
   }
   // The guard: a non-finite sample or runaway energy never leaves the voice.
-  const Energy e = scheme_->energy();
-  const double h = e.total();
+  const double h = energy();
   if (!finite || !std::isfinite(h) || h > patch_.guardEnergyMultiple * injected_) {
     silence(left, right, rightCount);
     ++guardEvents_;

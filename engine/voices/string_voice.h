@@ -7,12 +7,14 @@
 #include <memory>
 #include <optional>
 #include <span>
+#include <utility>
 
 #include "instruments/bridge.h"
 #include "instruments/hammer.h"
 #include "instruments/string_tuning.h"
 #include "schemes/sav.h"
 #include "voices/decimator.h"
+#include "voices/modal_tail.h"
 #include "voices/pickup.h"
 #include "voices/voice_block.h"
 
@@ -64,6 +66,9 @@ constexpr double kNoDamperT60 = 1000.0;  // s
 // linear_below's largest value: a relative tension change that puts the pitch off by at most
 // 866 × it cents, 0.87.
 constexpr double kMaxLinearBelow = 1e-3;
+// The modal tail's floor: the highest modes of a linear string are dropped while together they hold
+// under this share of its energy (−100 dB), checked every kLinearCheckSteps steps.
+constexpr double kModalFloor = 1e-10;
 // The most a string is detuned from its note, cents: its unison spread and its bridge's load.
 constexpr double kMaxDetuneCents = 50.0;
 
@@ -127,6 +132,13 @@ class StringVoice {
   // cost. A preset without the tail (linear_below 0) keeps none. A string gone linear stays so
   // when it ends (until struck, or over twice the threshold it went linear at).
   void setLiveTail(bool on) noexcept { liveTail_ = on; }
+  // The linear tail in the string's modes (modal_tail.h): on (the default), a linear string with no
+  // felt damper on it steps its modes, the highest dropped while together they hold under `floor`
+  // of its energy (0: none); off, it steps its nodes. The same linear string either way, to
+  // roundoff and the dropped modes. Off leaves the modes at once.
+  void setModalTail(bool on, double floor = kModalFloor) noexcept;
+  bool inModes() const { return inModes_; }  // stepping its modes now
+  const ModalTail& modalTail() const { return modal_; }
   // The live tail changes something: the string takes the linear tail, below kMaxLinearBelow.
   bool takesLiveTail() const { return linearisable_ && patch_.linearBelow < kMaxLinearBelow; }
   // Where the voice counts as silent and frees itself (QuietDetector::setFloor): in its output
@@ -144,13 +156,21 @@ class StringVoice {
   // output sample (gain applied); pullOnBridge() is the string's force on the bridge at q^n.
   void wake() noexcept;
   bool stepOnBridge(double w, double out[2]) noexcept;
-  double pullOnBridge(double w) const noexcept { return coupling_.forceOnBridge(scheme_->q(), w); }
+  double pullOnBridge(double w) const noexcept {
+    using enum ModalTail::Probe;
+    return inModes_ ? coupling_.forceFromPull(modal_.at(kPull), w)
+                    : coupling_.forceOnBridge(scheme_->q(), w);
+  }
   // The string's tension change at its bridge end at q^n, N (NonlinearString::endTension()).
   // That of the linear string where the last step was linear (the switch back comes after it).
   double endTension() const noexcept {
     const NonlinearString& s = scheme_->system().string();
-    return steppedLinear_ ? s.linearEndTension(scheme_->q()) : s.endTension();
+    if (!steppedLinear_) return s.endTension();
+    return inModes_ ? s.linearEndTension(modal_.lastLongitudinal())
+                    : s.linearEndTension(scheme_->q());
   }
+  // The coupling's E_c^{n+½} (BridgeCoupling::energy) with the bridge at w^n, w^{n+1}.
+  double couplingEnergy(double w, double wNext) const noexcept;
   const BridgeCoupling& coupling() const { return coupling_; }
   const StringPatch& patch() const { return patch_; }
   // The nodes of u (coordinates of q) under a felt damper; none with the uniform one or none.
@@ -164,15 +184,19 @@ class StringVoice {
   // By the strikes, the bend's retensioning and the linear tail's switches (what ψ held against
   // V''s quadratic part at rest, either sign).
   double injectedEnergy() const { return injected_; }
-  // Taken out by the back-check (the hammer's kinetic energy and its ψ residual). The string's
-  // losses are not tallied on the audio path; with them off, energy() + removedEnergy() stays
-  // injectedEnergy().
+  // Taken out by the back-check (the hammer's kinetic energy and its ψ residual) and by the modal
+  // tail's dropped modes. The string's losses are not tallied on the audio path; with them off,
+  // energy() + removedEnergy() stays injectedEnergy().
   double removedEnergy() const { return caught_; }
   int guardEvents() const { return guardEvents_; }
   double fundamentalHz() const { return fundamental_; }
   int channels() const { return patch_.channels; }
   int segments() const;
+  // The scheme; while the string steps its modes (inModes()), its levels are those it left.
   const SplitSav<HammeredString>& scheme() const { return *scheme_; }
+  // q^n and q^{n+1} as the string steps them: the scheme's, or the modes written back. Allocates
+  // (for tests and tools).
+  std::pair<Vector, Vector> levels() const;
 
  private:
   // A pickup at a fraction of L: the two nodes of u around it and their linear weights, fixed
@@ -186,8 +210,13 @@ class StringVoice {
   void catchHammer() noexcept;
   void applyBend() noexcept;
   bool stepAndPick(double out[2]) noexcept;  // one scheme step; true when a sample is out
+  void stepModes() noexcept;                 // the step in the modes, the hammer checked
   void checkLinear() noexcept;               // every kLinearCheckSteps steps
   void setLinear(bool on) noexcept;
+  void prepareModes();
+  void retuneModes() noexcept;
+  void enterModes() noexcept;  // where it may: linear, no damper on it, the modal tail on
+  void leaveModes() noexcept;
 
   StringPatch patch_;
   std::unique_ptr<SplitSav<HammeredString>> scheme_;
@@ -211,6 +240,17 @@ class StringVoice {
   bool linearisable_ = false, linear_ = false, steppedLinear_ = false;
   bool liveTail_ = false;
   double linearAt_ = 0.0;  // the threshold in effect when the string last went linear
+  // The modal tail: the modes, whether they step, the energy the scheme holds beside them (the ψ
+  // of its parts, the parked hammer), the steps taken since the scheme's own, and the two levels
+  // the modes are written back into.
+  ModalTail modal_;
+  bool modalTail_ = true, inModes_ = false;
+  double modalFloor_ = kModalFloor;
+  double besideModes_ = 0.0;
+  long stepsInModes_ = 0;
+  Vector levelN_, levelNext_;
+  long steps_ = 0;         // since reset(): the linear tail's check counts them
+  double bridgeAt_ = 0.0;  // w of the step (stepOnBridge); 0 off a bridge
 };
 
 }  // namespace hamiltone

@@ -101,6 +101,43 @@ int main() {
         synth.activeVoices() != static_cast<int>(std::size(testing::kPerformanceNotes)))
       ++failures;
   }
+  // The modal tail (voices/modal_tail.h) in the callback: the chord struck softly under the pedal
+  // with the live tail on, so that its strings go linear and into their modes within 3 s and drop
+  // modes as they decay; struck again, they leave them (and, struck this softly, take them again
+  // within 0.1 s).
+  {
+    Synth synth;
+    SynthSetup setup = testing::performanceSetup(48000.0);
+    setup.threads = 3;
+    synth.prepare(instruments, setup);
+    synth.setLiveTail(true);
+    SpscQueue<app::StampedMessage> midi(256);
+    app::Player player(synth, midi, nullptr, 48000.0 / kGuardOff, 256);
+    testing::SampleFaults faults;
+    std::vector<float> interleaved(2 * 256);
+    const double period = 256 / (48000.0 / kGuardOff);
+    int inModes = 0, struck = 0;
+    for (long n = 0; n < 3 * 48000 / 256 + 20; ++n) {
+      const std::int64_t nowNs = testing::nanoseconds(static_cast<double>(n + 1) * period);
+      const std::int64_t arrival = nowNs - testing::nanoseconds(period);
+      if (n == 0) midi.push({arrival, {0xB0, 64, 127}});
+      if (n == 0 || n == 3 * 48000 / 256)
+        for (int note : testing::kPerformanceNotes)
+          midi.push({arrival, {0x90, static_cast<std::uint8_t>(note), 30}});
+      player.render(interleaved.data(), 256, nowNs);
+      faults.check(interleaved);
+      if (n == 3 * 48000 / 256 - 1) inModes = synth.stringsInModes();
+      if (n == 3 * 48000 / 256) struck = synth.stringsInModes();
+    }
+    std::printf(
+        "chord in its modal tail: %d strings in their modes after 3 s, %d at the strike, %d 0.1 s "
+        "on; %ld non-finite, %ld subnormal, %ld outside [-1, 1]\n",
+        inModes, struck, synth.stringsInModes(), faults.nonFinite, faults.subnormal,
+        faults.outOfRange);
+    std::fflush(stdout);
+    if (faults.any() || synth.nonFiniteSamples() > 0 || inModes == 0 || struck >= inModes)
+      ++failures;
+  }
   std::printf("%s\n", failures ? "FAILED" : "passed: no real-time violation, every sample clean");
   return failures ? 1 : 0;
 }

@@ -1,0 +1,185 @@
+#include "voices/modal_tail.h"
+
+#include <cmath>
+#include <numbers>
+
+namespace hamiltone {
+
+void ModalTail::Grid::prepare(int segments, double spacing, double rhoA) {
+  modes = kept = segments - 1;
+  mass = rhoA * spacing;
+  for (std::vector<double>* x : {&levels[0], &levels[1], &c1, &c2, &kappa, &gamma})
+    x->assign(modes, 0.0);
+  sines.resize(2 * static_cast<size_t>(segments));
+  for (int t = 0; t < 2 * segments; ++t) sines[t] = std::sin(std::numbers::pi * t / segments);
+}
+
+// out_i = sqrt(2/M) Σ_{t=1…terms} in_t sin(π i t / M) for i = 1 … M − 1 (in_t at in[t − 1]): the
+// sine transform (DST-I), its own inverse — node values to modes with every node, the kept modes
+// back to node values. The table's index (i t) mod 2M is taken by steps of i.
+void ModalTail::Grid::sineSum(const double* in, int terms, double* out) const noexcept {
+  const int segments = modes + 1, period = 2 * segments;
+  const double scale = std::sqrt(2.0 / segments);
+  for (int i = 1; i <= modes; ++i) {
+    double sum = 0.0;
+    for (int t = 1, index = i; t <= terms; ++t) {
+      sum += in[t - 1] * sines[index];
+      index += i;
+      if (index >= period) index -= period;
+    }
+    out[i - 1] = scale * sum;
+  }
+}
+
+// Mode m's share of (41) with the loss's correction (linear_loss.h): with Δ = a^{n+1} − a^n,
+// m0 (½ Δ²/k² − σ1/(2k) γ Δ² + ½ κ a^{n+1} a^n), m0 the grid's mass per node.
+double ModalTail::Grid::modeEnergy(int m, double k, double sigma1) const noexcept {
+  const double a = now()[m], aNext = next()[m], d = aNext - a;
+  return mass *
+         (0.5 * d * d / (k * k) - 0.5 * sigma1 / k * gamma[m] * d * d + 0.5 * kappa[m] * aNext * a);
+}
+
+void ModalTail::prepare(const NonlinearString& string, double k,
+                        const std::array<std::vector<double>, kProbes>& probes, Eigen::Index last,
+                        Eigen::Index second) {
+  const double rhoA = string.physics().linearDensity();
+  k_ = k;
+  u_.prepare(string.segments(), string.spacing(), rhoA);
+  v_.prepare(string.grid().longitudinal, string.longitudinalSpacing(), rhoA);
+  for (int p = 0; p < kProbes; ++p) {
+    weights_[p].assign(u_.modes, 0.0);
+    if (p != kPull) u_.sineSum(probes[p].data(), u_.modes, weights_[p].data());
+  }
+  auto nodeWeights = [&](Eigen::Index j, std::vector<double>& out) {
+    std::vector<double> unit(u_.modes, 0.0);
+    unit[j] = 1.0;
+    out.assign(u_.modes, 0.0);
+    u_.sineSum(unit.data(), u_.modes, out.data());
+  };
+  nodeWeights(last, lastNode_);
+  nodeWeights(second, secondNode_);
+  vEnd_.assign(v_.modes, 0.0);
+  if (v_.modes > 0) {
+    std::vector<double> unit(v_.modes, 0.0);
+    unit.back() = 1.0;
+    v_.sineSum(unit.data(), v_.modes, vEnd_.data());
+  }
+  setCoefficients(string, 0.0, 0.0);
+}
+
+// κ_m, γ_m: M⁻¹K and M⁻¹C of mode m. On u, (βT0 λ + EI λ²)/ρA (transverseEigenvalue) and w_u λ,
+// λ = (4/h²) sin²(πm/2M) the eigenvalue of −D2; on v, at EA, EA λ_v/ρA and w_v0 + w_v1 λ_v.
+void ModalTail::setCoefficients(const NonlinearString& string, double sigma0, double sigma1) {
+  const double k = k_, kk = k * k, up = 1.0 + sigma0 * k, down = 1.0 - sigma0 * k;
+  const double cs = 2.0 * sigma1 * k;
+  sigma1_ = sigma1;
+  const NonlinearString::LossWeights& w = string.lossWeights();
+  auto fill = [&](Grid& g, auto kappaOf, auto gammaOf) {
+    const int segments = g.modes + 1;
+    for (int m = 1; m <= g.modes; ++m) {
+      const double s = std::sin(m * std::numbers::pi / (2.0 * segments));
+      g.kappa[m - 1] = kappaOf(m, s);
+      g.gamma[m - 1] = gammaOf(s);
+      g.c1[m - 1] = (2.0 - kk * g.kappa[m - 1] - cs * g.gamma[m - 1]) / up;
+      g.c2[m - 1] = (down - cs * g.gamma[m - 1]) / up;
+    }
+  };
+  const double h = string.spacing(), hv = string.longitudinalSpacing();
+  const StringPhysics& p = string.physics();
+  fill(
+      u_, [&](int m, double) { return string.transverseEigenvalue(m); },
+      [&](double s) { return w.transverse * 4.0 / (h * h) * s * s; });
+  fill(
+      v_,
+      [&](int, double s) { return p.young * p.area / p.linearDensity() * 4.0 / (hv * hv) * s * s; },
+      [&](double s) { return w.longitudinalConstant + w.longitudinal * 4.0 / (hv * hv) * s * s; });
+  forceScale_ = kk / (u_.mass * up);
+}
+
+void ModalTail::setPull(double c1, double c2) noexcept {
+  for (int m = 0; m < u_.modes; ++m) weights_[kPull][m] = c1 * lastNode_[m] + c2 * secondNode_[m];
+}
+
+void ModalTail::enter(const Vector& q, const Vector& qNext) noexcept {
+  const int nu = u_.modes;
+  u_.sineSum(q.data(), u_.modes, u_.now());
+  u_.sineSum(qNext.data(), u_.modes, u_.next());
+  v_.sineSum(q.data() + nu, v_.modes, v_.now());
+  v_.sineSum(qNext.data() + nu, v_.modes, v_.next());
+  u_.kept = u_.modes;
+  v_.kept = v_.modes;
+  probeAll();
+}
+
+// The probes at both levels from the kept modes alone.
+void ModalTail::probeAll() noexcept {
+  for (int p = 0; p < kProbes; ++p) {
+    double n = 0.0, next = 0.0;
+    for (int m = 0; m < u_.kept; ++m) {
+      n += weights_[p][m] * u_.now()[m];
+      next += weights_[p][m] * u_.next()[m];
+    }
+    now_[p] = n;
+    next_[p] = next;
+  }
+  double n = 0.0, next = 0.0;
+  for (int m = 0; m < v_.kept; ++m) {
+    n += vEnd_[m] * v_.now()[m];
+    next += vEnd_[m] * v_.next()[m];
+  }
+  vLast_ = n;
+  vLastNext_ = next;
+}
+
+void ModalTail::leave(Vector& q, Vector& qNext) const noexcept {
+  const int nu = u_.modes;
+  u_.sineSum(u_.now(), u_.kept, q.data());
+  u_.sineSum(u_.next(), u_.kept, qNext.data());
+  v_.sineSum(v_.now(), v_.kept, q.data() + nu);
+  v_.sineSum(v_.next(), v_.kept, qNext.data() + nu);
+}
+
+// The step writes level n + 2 over level n, which then takes the name of n + 1.
+void ModalTail::step(double w) noexcept {
+  now_ = next_;
+  vLast_ = vLastNext_;
+  const double* weights[kProbes];
+  for (int p = 0; p < kProbes; ++p) weights[p] = weights_[p].data();
+  kernels_->modalStep(u_.kept, u_.c1.data(), u_.c2.data(), weights, -forceScale_ * w, u_.now(),
+                      u_.next(), next_.data());
+  u_.newer = 1 - u_.newer;
+  double* older = v_.now();
+  const double *newer = v_.next(), *c1 = v_.c1.data(), *c2 = v_.c2.data(), *e = vEnd_.data();
+  double last = 0.0;
+  for (int m = 0; m < v_.kept; ++m) {
+    older[m] = c1[m] * newer[m] - c2[m] * older[m];
+    last += e[m] * older[m];
+  }
+  v_.newer = 1 - v_.newer;
+  vLastNext_ = last;
+}
+
+double ModalTail::energy() const noexcept {
+  double e = 0.0;
+  for (const Grid* g : {&u_, &v_})
+    for (int m = 0; m < g->kept; ++m) e += g->modeEnergy(m, k_, sigma1_);
+  return e;
+}
+
+double ModalTail::truncate(double floor) noexcept {
+  const double budget = floor * energy();
+  double dropped = 0.0;
+  for (Grid* g : {&u_, &v_}) {
+    while (g->kept > 0) {
+      const double e = g->modeEnergy(g->kept - 1, k_, sigma1_);
+      if (dropped + e >= budget) break;
+      dropped += e;
+      --g->kept;
+      g->now()[g->kept] = g->next()[g->kept] = 0.0;
+    }
+  }
+  probeAll();
+  return dropped;
+}
+
+}  // namespace hamiltone

@@ -1,0 +1,100 @@
+// The linear tail in the string's own modes (docs/string-grids.md, "The modal tail"). The linear
+// string of the scheme — K and C of one grid each for u and v, M diagonal and uniform on each,
+// simply supported ends — is diagonalised exactly by the sine transform (DST-I): mode m of a grid
+// of M segments is φ_m(j) = sqrt(2/M) sin(π m j / M), with M⁻¹K and M⁻¹C its eigenvalues κ_m and
+// γ_m. The linear step (sav.h, stepLinear: (38) with no part loaded, the loss (49))
+//   (1 + σ0k) q^{n+1} = (2 − k²M⁻¹K − 2σ1k M⁻¹C) q^n − (1 − σ0k − 2σ1k M⁻¹C) q^{n−1} + k²M⁻¹f
+// is then one recursion per mode, the bridge's point forces f entering through φ_m at their nodes
+// and every output (a pickup, the bridge's end nodes, the hammer's contact) a dot product with
+// the modes. The modes whose energy together is under a floor of the string's (−100 dB) are
+// dropped, highest first; the rest step as before. The same linear system, so its energy balance
+// holds step by step (energy()), less what a drop removes (returned by truncate()).
+#pragma once
+
+#include <array>
+#include <span>
+#include <vector>
+
+#include "instruments/string.h"
+#include "kernels/kernels.h"
+#include "schemes/hamiltonian.h"
+
+namespace hamiltone {
+
+class ModalTail {
+ public:
+  // The outputs read on u, each a linear functional Σ_j c_j u_j: the pickups and the hammer's
+  // contact by their node weights c, and the bridge's pull c1 u_{M−1} + c2 u_{M−2} (setPull). The
+  // bridge at w pushes the same nodes with −c1 w and −c2 w: a force along the pull's own weights.
+  enum Probe { kPickup0, kPickup1, kPull, kContact, kProbes };
+
+  // Sizes the tables for this string's grids (may allocate): the sine tables, and the probes'
+  // modal weights from their node weights (kProbes spans of u's M − 1 values; kPull's is unused)
+  // and the pull's nodes (q's indices of u_{M−1} and u_{M−2}). No pull until setPull().
+  void prepare(const NonlinearString& string, double k,
+               const std::array<std::vector<double>, kProbes>& probes, Eigen::Index last,
+               Eigen::Index second);
+  // The pull's weights c1, c2 (BridgeCoupling, with the bend). No allocation.
+  void setPull(double c1, double c2) noexcept;
+  // The modes' recursions for the string as bent now (its β) and the losses σ0, σ1 and its
+  // weights (the linear string: v at EA). No allocation.
+  void setCoefficients(const NonlinearString& string, double sigma0, double sigma1);
+  // The instruction set of the step (default: selectedKernels()).
+  void setKernels(const Kernels& kernels) noexcept { kernels_ = &kernels; }
+
+  // The string's u and v (the first (M − 1) + (Mv − 1) coordinates of q) at levels n and n + 1
+  // into every mode.
+  void enter(const Vector& q, const Vector& qNext) noexcept;
+  // The kept modes back to u and v at levels n and n + 1; the other coordinates are left alone.
+  void leave(Vector& q, Vector& qNext) const noexcept;
+
+  // One step with the bridge at w (m): the forces −c1 w and −c2 w on the pull's nodes.
+  void step(double w) noexcept;
+
+  // A probe at level n and at level n + 1.
+  double at(Probe p) const { return now_[p]; }
+  double atNext(Probe p) const { return next_[p]; }
+  // v at its last node (v_{Mv−1}) at level n; 0 with one coarse cell.
+  double lastLongitudinal() const { return vLast_; }
+
+  // H^{n+½} of the kept modes: the scheme's energy() of the linear string (kinetic with its σ1
+  // correction, ½ q^{n+1}ᵀ K q^n), J.
+  double energy() const noexcept;
+  // Drops the highest modes of u, then of v, while what they hold together stays under
+  // floor × energy(); returns the energy dropped.
+  double truncate(double floor) noexcept;
+  int keptTransverse() const { return u_.kept; }
+  int keptLongitudinal() const { return v_.kept; }
+
+ private:
+  // One grid's modes: amplitudes at levels n and n + 1 (the two arrays take turns), the
+  // recursion's coefficients a^{n+2} = c1 a^{n+1} − c2 a^n, M⁻¹K and M⁻¹C of each mode, and the
+  // sine table sin(π t / M), t < 2M.
+  struct Grid {
+    int modes = 0;  // M − 1
+    int kept = 0;
+    int newer = 1;      // levels[newer] holds n + 1, the other n
+    double mass = 0.0;  // ρA h on this grid: M's diagonal
+    std::vector<double> levels[2], c1, c2, kappa, gamma, sines;
+    double* now() { return levels[1 - newer].data(); }
+    double* next() { return levels[newer].data(); }
+    const double* now() const { return levels[1 - newer].data(); }
+    const double* next() const { return levels[newer].data(); }
+    void prepare(int segments, double spacing, double rhoA);
+    void sineSum(const double* in, int terms, double* out) const noexcept;  // DST-I, M − 1 out
+    double modeEnergy(int m, double k, double sigma1) const noexcept;
+  };
+  void probeAll() noexcept;
+
+  const Kernels* kernels_ = &selectedKernels();
+  Grid u_, v_;
+  double k_ = 0.0, sigma1_ = 0.0;
+  double forceScale_ = 0.0;  // k² / (ρA h (1 + σ0k)): a force's share of a mode's step
+  // The probes' modal weights, the pull's nodes', and v's last node's.
+  std::array<std::vector<double>, kProbes> weights_;
+  std::vector<double> lastNode_, secondNode_, vEnd_;
+  std::array<double, kProbes> now_{}, next_{};
+  double vLast_ = 0.0, vLastNext_ = 0.0;
+};
+
+}  // namespace hamiltone

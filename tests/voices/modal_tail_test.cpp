@@ -1,0 +1,231 @@
+// The linear tail in the string's modes (voices/modal_tail.h): the same linear string as the
+// scheme's nodes — its output, its probes and its energy to roundoff with no mode dropped — that
+// drops only what lies under its floor and hands the string back to its nodes where they are
+// needed: a strike, a felt damper, the modal tail turned off.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <vector>
+
+#include "instruments/piano_scale.h"
+#include "instruments/string_tuning.h"
+#include "support/energy_checks.h"
+#include "support/modal.h"
+#include "voices/string_voice.h"
+
+namespace hamiltone {
+namespace {
+
+constexpr double kRate = 48000.0;
+constexpr size_t kBlock = 64;
+
+// A grand-piano string with the live tail's threshold, so that it goes linear within a second or
+// two; stereo velocity pickups, as the grand piano has them.
+StringPatch piano(int note) {
+  StringPatch p;
+  p.string = pianoString(note);
+  p.linearBelow = kMaxLinearBelow;
+  p.bendRange = 0.0;
+  return p;
+}
+
+// One block of both channels, appended.
+void block(StringVoice& voice, std::vector<double>& out) {
+  std::vector<float> l(kBlock), r(kBlock);
+  voice.process(l, r);
+  for (size_t i = 0; i < kBlock; ++i) {
+    out.push_back(l[i]);
+    out.push_back(r[i]);
+  }
+}
+
+double peak(const std::vector<double>& x, size_t from = 0) {
+  double p = 0.0;
+  for (size_t i = from; i < x.size(); ++i) p = std::max(p, std::abs(x[i]));
+  return p;
+}
+
+double largestDifference(const std::vector<double>& a, const std::vector<double>& b,
+                         size_t from = 0) {
+  double d = 0.0;
+  for (size_t i = from; i < a.size(); ++i) d = std::max(d, std::abs(a[i] - b[i]));
+  return d;
+}
+
+// Plays `modal` and `nodal` (the same patch and strike) block by block until `modal` steps its
+// modes; returns false if it never does within 10 s.
+bool untilModal(StringVoice& modal, StringVoice& nodal, std::vector<double>& a,
+                std::vector<double>& b) {
+  for (int i = 0; i < 10 * 750 && !modal.inModes(); ++i) {
+    block(modal, a);
+    block(nodal, b);
+  }
+  return modal.inModes();
+}
+
+// `voice` prepared with `patch` for `note`, struck at `velocity` and played until it steps its
+// modes; false if it never does within 10 s.
+bool struckIntoModes(StringVoice& voice, const StringPatch& patch, int note, double velocity) {
+  voice.prepare(patch, note, kRate);
+  voice.noteOn(velocity);
+  std::vector<double> out;
+  for (int i = 0; i < 10 * 750 && !voice.inModes(); ++i) block(voice, out);
+  return voice.inModes();
+}
+
+// With no mode dropped, the modes are the scheme's linear string in another basis: the two voices
+// agree to the bit until the switch (the check comes after a step's pickups), then to roundoff —
+// the transform's, and each step's sums taken in another order, which two stable recursions carry
+// on at most linearly: over 48000 steps of M ≤ 224 modes, about 48000 × 224 × 1e-16 ≈ 1e-9 of
+// the output at the most, and much less as the loss damps it — under the output's own rounding to
+// float, 2^-24 of a sample on each side. C2 (v on coarse cells), C4 and C6 (one coarse cell: no
+// v), a second after the switch.
+TEST(ModalTail, IsTheSchemesLinearStringToRoundoff) {
+  for (int note : {36, 60, 84}) {
+    StringVoice modal, nodal;
+    modal.prepare(piano(note), note, kRate);
+    nodal.prepare(piano(note), note, kRate);
+    modal.setModalTail(true, 0.0);
+    nodal.setModalTail(false);
+    modal.noteOn(0.5);
+    nodal.noteOn(0.5);
+    std::vector<double> a, b;
+    ASSERT_TRUE(untilModal(modal, nodal, a, b)) << "note " << note << " never went modal";
+    EXPECT_EQ(a, b) << "note " << note << " differs before its modes";
+    ASSERT_TRUE(nodal.linear());
+    const size_t switched = a.size();
+    for (int i = 0; i < 750; ++i) {
+      block(modal, a);
+      block(nodal, b);
+    }
+    ASSERT_TRUE(modal.inModes());
+    EXPECT_EQ(modal.modalTail().keptTransverse(), modal.segments() - 1);  // floor 0: all kept
+    const double scale = peak(b, switched);
+    const double difference = largestDifference(a, b, switched);
+    const double energy = nodal.energy();
+    std::printf("note %d: modes from %.2f s; a second on, output %.2e, energy %.2e of the nodes'\n",
+                note, static_cast<double>(switched) / (2 * kRate), difference / scale,
+                std::abs(modal.energy() - energy) / energy);
+    EXPECT_LE(difference, (1e-9 + 0x1p-23) * scale) << "note " << note;
+    EXPECT_NEAR(modal.energy(), energy, 1e-9 * energy) << "note " << note;
+  }
+}
+
+// What the string's step reads of itself through the modes — the hammer's contact, the bridge's
+// pull, v's end tension — is what it would read off its nodes: the modes written back (levels()).
+TEST(ModalTail, ItsProbesReadWhatTheNodesWould) {
+  for (int note : {36, 84}) {
+    StringVoice voice;
+    ASSERT_TRUE(struckIntoModes(voice, piano(note), note, 0.5));
+    std::vector<double> a;
+    for (int i = 0; i < 100; ++i) block(voice, a);
+    ASSERT_TRUE(voice.inModes());
+    const auto [q, qNext] = voice.levels();
+    const HammeredString& system = voice.scheme().system();
+    const double u = q.head(system.string().transverseSize()).cwiseAbs().maxCoeff();
+    const double w = 1e-6;  // m: the bridge somewhere near the string's end
+    EXPECT_NEAR(voice.modalTail().at(ModalTail::kContact), system.contactDisplacement(q),
+                1e-12 * u);
+    const BridgeCoupling& c = voice.coupling();
+    EXPECT_NEAR(voice.pullOnBridge(w), c.forceOnBridge(q, w),
+                1e-12 * (std::abs(c.lastWeight()) + std::abs(c.secondWeight())) * u);
+    const double end = system.string().linearEndTension(q);
+    EXPECT_NEAR(voice.endTension(), end, 1e-9 * std::abs(end) + 1e-15) << "note " << note;
+  }
+}
+
+// The floor drops the highest modes as they fall under 1e-10 of the string's energy, counted as
+// removed energy: C3 a few seconds into its tail keeps under half its modes, and its output is
+// that of all its modes within 1e-4 of the tail's peak — what the dropped modes held is under
+// −100 dB of the energy, a part in 1e5 of the amplitude, here summed over the drops and both
+// pickups.
+TEST(ModalTail, DropsOnlyWhatLiesUnderItsFloor) {
+  StringVoice floored, every;
+  floored.prepare(piano(48), 48, kRate);
+  every.prepare(piano(48), 48, kRate);
+  every.setModalTail(true, 0.0);
+  floored.noteOn(0.5);
+  every.noteOn(0.5);
+  std::vector<double> a, b;
+  ASSERT_TRUE(untilModal(floored, every, a, b));
+  const size_t switched = a.size();
+  for (int i = 0; i < 3 * 750; ++i) {
+    block(floored, a);
+    block(every, b);
+  }
+  ASSERT_TRUE(floored.inModes());
+  const int kept = floored.modalTail().keptTransverse(), modes = floored.segments() - 1;
+  const double difference = largestDifference(a, b, switched) / peak(b, switched);
+  std::printf("C3 3 s into its modes: %d of %d modes kept; output within %.2e of all modes'\n",
+              kept, modes, difference);
+  EXPECT_LT(kept, modes / 2);
+  EXPECT_LE(difference, 1e-4);
+  EXPECT_GT(floored.removedEnergy(), every.removedEnergy());
+}
+
+// The fundamental's T60 of a lossless C3 with a 0.3 s uniform damper released while it steps its
+// modes: the damper's σ0 reaches the modes' recursions (within 5 %, as on the nodes:
+// StringVoice.DamperShortensTheDecayToItsT60), and the string stays in them.
+TEST(ModalTail, AUniformDamperDampsTheModes) {
+  StringPatch patch = piano(48);
+  patch.t60Low = patch.t60High = INFINITY;
+  patch.damperT60 = 0.3;
+  StringVoice voice;  // pianissimo: lossless, only a soft strike falls under the threshold
+  ASSERT_TRUE(struckIntoModes(voice, patch, 48, 0.05));
+  voice.release();
+  ASSERT_TRUE(voice.inModes());
+  const double k = 1.0 / kRate;
+  const double omega =
+      2.0 * std::numbers::pi * schemePartial(voice.scheme().system().string(), k, 1);
+  std::vector<double> a, t, logE;
+  for (int i = 0; i < 0.12 * 750; ++i) {  // 0.12 s: 40 % of the T60, as the nodes' test
+    block(voice, a);
+    const auto [q, qNext] = voice.levels();
+    const double amplitude = testing::modalAmplitude(q, voice.segments(), 1);
+    const double rate = (testing::modalAmplitude(qNext, voice.segments(), 1) - amplitude) / k;
+    t.push_back(i * kBlock / kRate);
+    logE.push_back(std::log(rate * rate + omega * omega * amplitude * amplitude));
+  }
+  EXPECT_TRUE(voice.inModes());
+  const double t60 = 2.0 * 6.907755278982137 / -testing::leastSquaresSlope(t, logE);
+  EXPECT_NEAR(t60, 0.3, 0.05 * 0.3);
+}
+
+// The modes give the string back to its nodes where the scheme has what they lack: a strike (the
+// hammer's and V''s gradients), a felt damper's dashpots on the nodes under it, or the modal tail
+// turned off; each time with the energy account kept (the switch counted as injected, as the
+// linear tail's own switches are).
+TEST(ModalTail, LeavesItsModesWhereTheNodesAreNeeded) {
+  StringPatch patch = piano(48);
+  patch.feltDamper = true;
+  for (int how = 0; how < 3; ++how) {
+    StringVoice voice;
+    ASSERT_TRUE(struckIntoModes(voice, patch, 48, 0.5));
+    const double before = voice.energy();
+    if (how == 0) voice.noteOn(0.5);
+    if (how == 1) voice.release();
+    if (how == 2) voice.setModalTail(false);
+    EXPECT_FALSE(voice.inModes()) << "case " << how;
+    if (how != 0) {
+      // Leaving changes H only by the roundoff of the transform back, and it is counted.
+      EXPECT_NEAR(voice.energy(), before, 1e-9 * before) << "case " << how;
+      std::vector<double> a;
+      for (int i = 0; i < 8; ++i) block(voice, a);  // past a check: stays on the nodes
+      EXPECT_FALSE(voice.inModes()) << "case " << how;
+    } else {
+      EXPECT_FALSE(voice.linear());
+    }
+  }
+  // Without the felt, a release is a σ0 and the modes keep the string (above).
+  patch.feltDamper = false;
+  StringVoice voice;
+  ASSERT_TRUE(struckIntoModes(voice, patch, 48, 0.5));
+  voice.release();
+  EXPECT_TRUE(voice.inModes());
+}
+
+}  // namespace
+}  // namespace hamiltone
