@@ -53,16 +53,20 @@ class BridgeCoupling {
     return forceFromPull(c1_ * q[last_] + c2_ * q[second_], w);
   }
   // The same from the string's c1 u_{M−1} + c2 u_{M−2} (a string stepped in its modes,
-  // modal_tail.h, which reads it as one sum).
-  double forceFromPull(double pull, double w) const { return -pull - self_ * w; }
+  // modal_tail.h, which reads it as one sum), the self-stiffness less `residual`, the give of the
+  // modes it dropped (ModalTail::residual()).
+  double forceFromPull(double pull, double w, double residual = 0.0) const {
+    return -pull - (self_ - residual) * w;
+  }
   // E_c^{n+½} from q^n, q^{n+1}, w^n, w^{n+1}.
   double energy(const Vector& q, const Vector& qNext, double w, double wNext) const {
     return energy(c1_ * q[last_] + c2_ * q[second_], c1_ * qNext[last_] + c2_ * qNext[second_], w,
                   wNext);
   }
-  // The same from the string's c1 u_{M−1} + c2 u_{M−2} at levels n and n + 1.
-  double energy(double cq, double cqNext, double w, double wNext) const {
-    return 0.5 * (cqNext * w + cq * wNext) + 0.5 * self_ * wNext * w;
+  // The same from the string's c1 u_{M−1} + c2 u_{M−2} at levels n and n + 1 (and `residual` as in
+  // forceFromPull).
+  double energy(double cq, double cqNext, double w, double wNext, double residual = 0.0) const {
+    return 0.5 * (cqNext * w + cq * wNext) + 0.5 * (self_ - residual) * wNext * w;
   }
   // c1 and c2: the pull's weights on u_{M−1} and u_{M−2}, and the forces' on the string
   // (forceOnLast(w) = −c1 w).

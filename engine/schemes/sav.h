@@ -153,7 +153,8 @@ class SavScheme {
 
   // Sets the state to q^n = q, q^{n+1} = qNext, `steps` steps on — a state stepped elsewhere (a
   // string's linear tail in its modes, modal_tail.h), whose ψ_j the caller has kept consistent:
-  // the parts it leaves are slack or dropped. K q^n is taken again.
+  // the parts it leaves are slack or dropped. K q^n is taken again. What the steps taken elsewhere
+  // dissipated and were supplied is not in dissipated() and supplied().
   void setLevels(const Vector& q, const Vector& qNext, long steps) noexcept {
     prev_ = q;
     curr_ = qNext;

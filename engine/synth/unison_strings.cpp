@@ -71,6 +71,7 @@ bool UnisonStrings::takesLiveTail() const {
 }
 
 int UnisonStrings::stringsInModes() const {
+  if (!active()) return 0;  // a bridged key's strings stay active() after the key falls silent
   int count = 0;
   for (const StringVoice& s : strings_) count += s.active() && s.inModes();
   return count;

@@ -94,10 +94,27 @@ void ModalTail::setCoefficients(const NonlinearString& string, double sigma0, do
       [&](int, double s) { return p.young * p.area / p.linearDensity() * 4.0 / (hv * hv) * s * s; },
       [&](double s) { return w.longitudinalConstant + w.longitudinal * 4.0 / (hv * hv) * s * s; });
   forceScale_ = kk / (u_.mass * up);
+  takeResidual();
 }
 
 void ModalTail::setPull(double c1, double c2) noexcept {
   for (int m = 0; m < u_.modes; ++m) weights_[kPull][m] = c1 * lastNode_[m] + c2 * secondNode_[m];
+  probeAll();
+  takeResidual();
+}
+
+// A dropped mode still gives way to a force held on it: statically, by P_m f / (ρA h κ_m) (the
+// recursion's fixed point), which the pull reads as −w P_m² / (ρA h κ_m) of the bridge at w. Σ over
+// the dropped modes of P_m² / (ρA h κ_m) is that softness as a stiffness taken off the coupling's
+// own (BridgeCoupling::selfStiffness): the string's end as stiff as with all its modes, wherever
+// the bridge moves slowly beside them — the residual flexibility of a truncated modal system.
+void ModalTail::takeResidual() noexcept {
+  double r = 0.0;
+  for (int m = u_.kept; m < u_.modes; ++m) {
+    const double p = weights_[kPull][m];
+    r += p * p / (u_.mass * u_.kappa[m]);
+  }
+  residual_ = r;
 }
 
 void ModalTail::enter(const Vector& q, const Vector& qNext) noexcept {
@@ -109,6 +126,7 @@ void ModalTail::enter(const Vector& q, const Vector& qNext) noexcept {
   u_.kept = u_.modes;
   v_.kept = v_.modes;
   probeAll();
+  takeResidual();
 }
 
 // The probes at both levels from the kept modes alone.
@@ -169,6 +187,7 @@ double ModalTail::energy() const noexcept {
 double ModalTail::truncate(double floor) noexcept {
   const double budget = floor * energy();
   double dropped = 0.0;
+  if (budget <= 0.0) return dropped;
   for (Grid* g : {&u_, &v_}) {
     while (g->kept > 0) {
       const double e = g->modeEnergy(g->kept - 1, k_, sigma1_);
@@ -179,7 +198,14 @@ double ModalTail::truncate(double floor) noexcept {
     }
   }
   probeAll();
+  takeResidual();
   return dropped;
+}
+
+void ModalTail::restore() noexcept {
+  u_.kept = u_.modes;  // the dropped modes were set to rest
+  v_.kept = v_.modes;
+  takeResidual();
 }
 
 }  // namespace hamiltone

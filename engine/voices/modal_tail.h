@@ -7,8 +7,10 @@
 // is then one recursion per mode, the bridge's point forces f entering through φ_m at their nodes
 // and every output (a pickup, the bridge's end nodes, the hammer's contact) a dot product with
 // the modes. The modes whose energy together is under a floor of the string's (−100 dB) are
-// dropped, highest first; the rest step as before. The same linear system, so its energy balance
-// holds step by step (energy()), less what a drop removes (returned by truncate()).
+// dropped, highest first; the rest step as before, and what the dropped ones gave statically under
+// the bridge's force stays in the coupling as a softer self-stiffness (residual()). The same linear
+// system, so its energy balance holds step by step (energy()), less what a drop removes (returned
+// by truncate()).
 #pragma once
 
 #include <array>
@@ -39,8 +41,6 @@ class ModalTail {
   // The modes' recursions for the string as bent now (its β) and the losses σ0, σ1 and its
   // weights (the linear string: v at EA). No allocation.
   void setCoefficients(const NonlinearString& string, double sigma0, double sigma1);
-  // The instruction set of the step (default: selectedKernels()).
-  void setKernels(const Kernels& kernels) noexcept { kernels_ = &kernels; }
 
   // The string's u and v (the first (M − 1) + (Mv − 1) coordinates of q) at levels n and n + 1
   // into every mode.
@@ -61,8 +61,14 @@ class ModalTail {
   // correction, ½ q^{n+1}ᵀ K q^n), J.
   double energy() const noexcept;
   // Drops the highest modes of u, then of v, while what they hold together stays under
-  // floor × energy(); returns the energy dropped.
+  // floor × energy() (none at a floor of 0); returns the energy dropped.
   double truncate(double floor) noexcept;
+  // Takes every mode again, the dropped ones at rest (where a force may wake them: a strike of the
+  // key's other strings).
+  void restore() noexcept;
+  // The dropped modes' static give under the bridge's force, as a stiffness (N/m) to take off the
+  // coupling's own: see takeResidual(). 0 with every mode kept.
+  double residual() const { return residual_; }
   int keptTransverse() const { return u_.kept; }
   int keptLongitudinal() const { return v_.kept; }
 
@@ -85,6 +91,7 @@ class ModalTail {
     double modeEnergy(int m, double k, double sigma1) const noexcept;
   };
   void probeAll() noexcept;
+  void takeResidual() noexcept;
 
   const Kernels* kernels_ = &selectedKernels();
   Grid u_, v_;
@@ -95,6 +102,7 @@ class ModalTail {
   std::vector<double> lastNode_, secondNode_, vEnd_;
   std::array<double, kProbes> now_{}, next_{};
   double vLast_ = 0.0, vLastNext_ = 0.0;
+  double residual_ = 0.0;
 };
 
 }  // namespace hamiltone

@@ -400,7 +400,8 @@ void StringVoice::reset() noexcept {
   active_ = struck_ = linear_ = steppedLinear_ = inModes_ = false;  // the copy is geometric
   parked_ = true;
   steps_ = stepsInModes_ = 0;
-  bridgeAt_ = 0.0;
+  bridgeAt_ = bridgeBefore_ = 0.0;
+  modesDue_ = ModesDue::none;
   applyBend();  // the copy brought back β = 1
 }
 
@@ -435,7 +436,7 @@ double StringVoice::energy() const {
 double StringVoice::couplingEnergy(double w, double wNext) const noexcept {
   if (!inModes_) return coupling_.energy(scheme_->q(), scheme_->qNext(), w, wNext);
   using enum ModalTail::Probe;
-  return coupling_.energy(modal_.at(kPull), modal_.atNext(kPull), w, wNext);
+  return coupling_.energy(modal_.at(kPull), modal_.atNext(kPull), w, wNext, modal_.residual());
 }
 
 void StringVoice::noteOn(double velocity) noexcept {
@@ -474,13 +475,18 @@ void StringVoice::liftDamper() noexcept {
 }
 
 void StringVoice::wake() noexcept {
-  if (active_) return;
+  if (active_) {
+    // The key's other strings struck: the bridge may wake the modes this string dropped.
+    if (inModes_) modesDue_ = ModesDue::restore;
+    return;
+  }
   reset();
   quiet_.strike();
   active_ = true;
 }
 
 bool StringVoice::stepOnBridge(double w, double out[2]) noexcept {
+  bridgeBefore_ = bridgeAt_;
   bridgeAt_ = w;
   scheme_->setPointForce(0, coupling_.lastIndex(), coupling_.forceOnLast(w));
   scheme_->setPointForce(1, coupling_.secondIndex(), coupling_.forceOnSecond(w));
@@ -562,8 +568,8 @@ double StringVoice::pickup(const Vector& q, const Vector& qNext, const PickupTap
 // string, or a bend down) it is geometric again. Each switch
 // changes the energy by what ψ held less the quadratic part, counted with what the strikes put
 // in. Checked at fixed step counts, so the output does not depend on the block size. A linear
-// string with no damper on it then steps its modes, the highest of them dropped as they fall under
-// kModalFloor of its energy (what they held counted as removed).
+// string with no felt damper on it then steps its modes, the highest of them dropped as they fall
+// under kModalFloor of its energy (what they held counted as removed) at the next step's start.
 void StringVoice::checkLinear() noexcept {
   const NonlinearString& string = scheme_->system().string();
   const StringPhysics& p = string.physics();
@@ -579,7 +585,7 @@ void StringVoice::checkLinear() noexcept {
     setLinear(false);
   }
   if (linear_ && !inModes_) enterModes();
-  if (inModes_) caught_ += modal_.truncate(modalFloor_);
+  if (inModes_) modesDue_ = ModesDue::truncate;
 }
 
 void StringVoice::setLinear(bool on) noexcept {
@@ -610,41 +616,50 @@ void StringVoice::retuneModes() noexcept {
 // The scheme's ψ and its parked hammer stay as they are while the modes step: what they hold of
 // the energy is kept beside the modes' (with the transform's roundoff), so energy() goes on.
 void StringVoice::enterModes() noexcept {
-  if (!modalTail_ || !linear_ || scheme_->damped()) return;
+  if (!modalTail_ || !linear_ || !parked_ || scheme_->damped()) return;
   const double before = energy();
   retuneModes();
-  modal_.enter(scheme_->q(), scheme_->qNext());
+  modal_.enter(scheme_->q(), scheme_->qNext());  // every mode kept: the coupling as on the nodes
   besideModes_ = before - modal_.energy();
   stepsInModes_ = 0;
   inModes_ = true;
 }
 
+// The modes dropped come back at rest, and with them the coupling's full self-stiffness: the
+// coupling energy's change (½ residual w^n w^{n+1}) is counted as injected.
 void StringVoice::leaveModes() noexcept {
-  const double before = energy();
+  const double before = energy() + couplingEnergy(bridgeBefore_, bridgeAt_);
   levelN_ = scheme_->q();  // the same size: no allocation
   levelNext_ = scheme_->qNext();
   modal_.leave(levelN_, levelNext_);
   scheme_->setLevels(levelN_, levelNext_, stepsInModes_);
   inModes_ = false;
-  injected_ += energy() - before;
+  modesDue_ = ModesDue::none;
+  injected_ += energy() + couplingEnergy(bridgeBefore_, bridgeAt_) - before;
 }
 
-// The hammer stays parked while the modes step; should the string swing down onto it, the scheme
-// takes the string back at level n and the back-check meets the hammer as on the nodes.
-void StringVoice::stepModes() noexcept {
-  modal_.step(bridgeAt_);
-  ++stepsInModes_;
-  const double hammer = scheme_->q()[scheme_->system().hammerIndex()];
-  if (hammer - modal_.at(ModalTail::kContact) > 0.0) {
-    leaveModes();
-    catchHammer();
-  }
+void StringVoice::changeModes() noexcept {
+  const double before = couplingEnergy(bridgeBefore_, bridgeAt_);
+  if (modesDue_ == ModesDue::truncate)
+    caught_ += modal_.truncate(modalFloor_);
+  else
+    modal_.restore();
+  injected_ += couplingEnergy(bridgeBefore_, bridgeAt_) - before;
+  modesDue_ = ModesDue::none;
 }
 
 bool StringVoice::stepAndPick(double out[2]) noexcept {
   steppedLinear_ = linear_;
   if (inModes_) {
-    stepModes();
+    if (modesDue_ != ModesDue::none) changeModes();
+    // The hammer parked below: should the string swing down onto it, the step is the scheme's,
+    // with the felt's force, and the back-check meets the hammer as on the nodes.
+    const double hammer = scheme_->q()[scheme_->system().hammerIndex()];
+    if (hammer - modal_.atNext(ModalTail::kContact) > 0.0) leaveModes();
+  }
+  if (inModes_) {
+    modal_.step(bridgeAt_);
+    ++stepsInModes_;
   } else {
     scheme_->step();
     catchHammer();

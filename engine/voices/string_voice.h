@@ -158,7 +158,7 @@ class StringVoice {
   bool stepOnBridge(double w, double out[2]) noexcept;
   double pullOnBridge(double w) const noexcept {
     using enum ModalTail::Probe;
-    return inModes_ ? coupling_.forceFromPull(modal_.at(kPull), w)
+    return inModes_ ? coupling_.forceFromPull(modal_.at(kPull), w, modal_.residual())
                     : coupling_.forceOnBridge(scheme_->q(), w);
   }
   // The string's tension change at its bridge end at q^n, N (NonlinearString::endTension()).
@@ -210,8 +210,8 @@ class StringVoice {
   void catchHammer() noexcept;
   void applyBend() noexcept;
   bool stepAndPick(double out[2]) noexcept;  // one scheme step; true when a sample is out
-  void stepModes() noexcept;                 // the step in the modes, the hammer checked
-  void checkLinear() noexcept;               // every kLinearCheckSteps steps
+  void changeModes() noexcept;  // the modes kept: dropped or restored, as modesDue_ says
+  void checkLinear() noexcept;  // every kLinearCheckSteps steps
   void setLinear(bool on) noexcept;
   void prepareModes();
   void retuneModes() noexcept;
@@ -249,8 +249,13 @@ class StringVoice {
   double besideModes_ = 0.0;
   long stepsInModes_ = 0;
   Vector levelN_, levelNext_;
-  long steps_ = 0;         // since reset(): the linear tail's check counts them
-  double bridgeAt_ = 0.0;  // w of the step (stepOnBridge); 0 off a bridge
+  long steps_ = 0;  // since reset(): the linear tail's check counts them
+  // The bridge's w of the last step and of the one before (stepOnBridge); 0 off a bridge: the
+  // levels of the coupling's energy between two steps.
+  double bridgeAt_ = 0.0, bridgeBefore_ = 0.0;
+  // A change of the modes kept, made at the start of the next step, where the bridge's two levels
+  // are known, so that the coupling energy it changes is counted.
+  enum class ModesDue { none, truncate, restore } modesDue_ = ModesDue::none;
 };
 
 }  // namespace hamiltone

@@ -234,6 +234,38 @@ TEST(Kernels, SchemeSumsAgreeWithinTheirReorderingBound) {
   }
 }
 
+// The modal tail's step (voices/modal_tail.h): the recursion element by element, the same bits on
+// every path as written out; the four probes' sums within their reordering bound.
+TEST(Kernels, TheModalStepIsTheRecursionOnEveryPath) {
+  std::vector<const Kernels*> paths = otherPaths();
+  paths.push_back(&kernelsFor(Isa::portable));
+  for (long n : {1L, 3L, 8L, 13L, 120L}) {
+    const std::vector<double> c1 = randomArray(n, 2.0, 3), c2 = randomArray(n, 1.0, 4),
+                              newer = randomArray(n, 1e-4, 5), older = randomArray(n, 1e-4, 6);
+    std::vector<std::vector<double>> w;
+    for (unsigned p = 0; p < 4; ++p) w.push_back(randomArray(n, 1.0, 7 + p));
+    const double* weights[4] = {w[0].data(), w[1].data(), w[2].data(), w[3].data()};
+    const double f = 3e-6;
+    std::vector<double> expected(n);
+    double bound[4] = {};
+    for (long m = 0; m < n; ++m) {
+      expected[m] = c1[m] * newer[m] - c2[m] * older[m] + f * w[2][m];
+      for (int p = 0; p < 4; ++p) bound[p] += std::abs(w[p][m] * expected[m]);
+    }
+    for (const Kernels* path : paths) {
+      std::vector<double> x = older;
+      double out[4];
+      path->modalStep(n, c1.data(), c2.data(), weights, f, x.data(), newer.data(), out);
+      EXPECT_EQ(x, expected) << path->name << " n = " << n;
+      for (int p = 0; p < 4; ++p) {
+        double sum = 0.0;
+        for (long m = 0; m < n; ++m) sum += w[p][m] * expected[m];
+        EXPECT_NEAR(out[p], sum, n * 1.2e-16 * bound[p]) << path->name << " probe " << p;
+      }
+    }
+  }
+}
+
 // The C3 string on two grids struck at 3 m/s, 0.02 s (960 steps: the strike and 15 ms after, as in
 // hammer_test) with loss, on each path: the balance (50) closes to the same roundoff as the
 // portable run's (hammer_test), and the paths part only by roundoff amplified by the dynamics:
