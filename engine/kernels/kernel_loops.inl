@@ -244,6 +244,40 @@ HAMILTONE_TARGET void modalStep(long n, const double* c1, const double* c2, cons
 // along the rows as written, whatever the compiler's cost model).
 typedef double Lanes __attribute__((vector_size(kLanes * sizeof(double))));
 
+// `Rows` registers of rows from row i on, side by side: each row's recurrence is a chain of a
+// product and a difference a step, so several run at once.
+template <int Rows>
+HAMILTONE_TARGET void sineRows(long i, long n, long terms, const double* in, const double* sinTheta,
+                               const double* twoCos, double scale, double* out) {
+  Lanes before[Rows] = {}, now[Rows], twoC[Rows], sum[Rows] = {};
+  for (int r = 0; r < Rows; ++r) {
+    __builtin_memcpy(&now[r], sinTheta + i + r * kLanes, sizeof(Lanes));
+    __builtin_memcpy(&twoC[r], twoCos + i + r * kLanes, sizeof(Lanes));
+  }
+  for (long t = 0; t < terms; ++t) {
+    for (int r = 0; r < Rows; ++r) {
+      sum[r] += in[t] * now[r];
+      const Lanes next = twoC[r] * now[r] - before[r];
+      before[r] = now[r];
+      now[r] = next;
+    }
+  }
+  for (int r = 0; r < Rows; ++r) {
+    sum[r] *= scale;
+    const long count = std::min<long>(kLanes, n - i - r * kLanes);  // out holds n values
+    if (count > 0) __builtin_memcpy(out + i + r * kLanes, &sum[r], count * sizeof(double));
+  }
+}
+
+HAMILTONE_TARGET void sineSums(long n, long terms, const double* in, const double* sinTheta,
+                               const double* twoCos, double scale, double* out) {
+  constexpr long kRows = 4;
+  long i = 0;
+  for (; i + kRows * kLanes <= n; i += kRows * kLanes)
+    sineRows<kRows>(i, n, terms, in, sinTheta, twoCos, scale, out);
+  for (; i < n; i += kLanes) sineRows<1>(i, n, terms, in, sinTheta, twoCos, scale, out);
+}
+
 HAMILTONE_TARGET void matrixProduct(const double* a, long lda, const double* b, long ldb,
                                     long stepB, double* c, long ldc, long m, long k, long n) {
   // One register of rows × four columns of C held in registers while p runs; the last block's
@@ -321,6 +355,7 @@ extern const Kernels kernels{.isa = HAMILTONE_KERNEL_ISA,
                              .savUpdate = savUpdate,
                              .linearUpdate = linearUpdate,
                              .modalStep = modalStep,
+                             .sineSums = sineSums,
                              .matrixProduct = matrixProduct,
                              .gridLaplacian = gridLaplacian,
                              .gridCells = gridCells,

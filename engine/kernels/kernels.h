@@ -72,6 +72,13 @@ struct Kernels {
   void (*modalStep)(long n, const double* c1, const double* c2, const double* const* w, double f,
                     double* older, const double* newer, double out[4]);
 
+  // The modal tail's sine transform (DST-I, unnormalised): out_i = scale Σ_{t<terms} in_t
+  // sin((t + 1) θ_i) for i < n, from sin θ_i and 2 cos θ_i (kMaxLanes values past n, finite),
+  // the sines by their recurrence sin((t+1)θ) = 2 cos θ sin(tθ) − sin((t−1)θ), each row apart: the
+  // same bits on every path.
+  void (*sineSums)(long n, long terms, const double* in, const double* sinTheta,
+                   const double* twoCos, double scale, double* out);
+
   // The plate's loops. C = A B, column-major, A m × k (leading dimension lda), B k × n read as
   // b_pj = b[stepB p + ldb j], C m × n; m a multiple of 8. Each c_ij is Σ_p a_ip b_pj summed in
   // order of p: the same bits on every path.

@@ -10,25 +10,21 @@ void ModalTail::Grid::prepare(int segments, double spacing, double rhoA) {
   mass = rhoA * spacing;
   for (std::vector<double>* x : {&levels[0], &levels[1], &c1, &c2, &kappa, &gamma})
     x->assign(modes, 0.0);
-  sines.resize(2 * static_cast<size_t>(segments));
-  for (int t = 0; t < 2 * segments; ++t) sines[t] = std::sin(std::numbers::pi * t / segments);
+  sinTheta.assign(modes + kMaxLanes, 0.0);  // θ_i = π i / M, padded for the kernel's last lanes
+  twoCos.assign(modes + kMaxLanes, 0.0);
+  for (int i = 1; i <= modes; ++i) {
+    sinTheta[i - 1] = std::sin(std::numbers::pi * i / segments);
+    twoCos[i - 1] = 2.0 * std::cos(std::numbers::pi * i / segments);
+  }
 }
 
 // out_i = sqrt(2/M) Σ_{t=1…terms} in_t sin(π i t / M) for i = 1 … M − 1 (in_t at in[t − 1]): the
 // sine transform (DST-I), its own inverse — node values to modes with every node, the kept modes
-// back to node values. The table's index (i t) mod 2M is taken by steps of i.
-void ModalTail::Grid::sineSum(const double* in, int terms, double* out) const noexcept {
-  const int segments = modes + 1, period = 2 * segments;
-  const double scale = std::sqrt(2.0 / segments);
-  for (int i = 1; i <= modes; ++i) {
-    double sum = 0.0;
-    for (int t = 1, index = i; t <= terms; ++t) {
-      sum += in[t - 1] * sines[index];
-      index += i;
-      if (index >= period) index -= period;
-    }
-    out[i - 1] = scale * sum;
-  }
+// back to node values.
+void ModalTail::Grid::sineSum(const Kernels& kernels, const double* in, int terms,
+                              double* out) const noexcept {
+  kernels.sineSums(modes, terms, in, sinTheta.data(), twoCos.data(), std::sqrt(2.0 / (modes + 1)),
+                   out);
 }
 
 // Mode m's share of (41) with the loss's correction (linear_loss.h): with Δ = a^{n+1} − a^n,
@@ -48,13 +44,13 @@ void ModalTail::prepare(const NonlinearString& string, double k,
   v_.prepare(string.grid().longitudinal, string.longitudinalSpacing(), rhoA);
   for (int p = 0; p < kProbes; ++p) {
     weights_[p].assign(u_.modes, 0.0);
-    if (p != kPull) u_.sineSum(probes[p].data(), u_.modes, weights_[p].data());
+    if (p != kPull) u_.sineSum(*kernels_, probes[p].data(), u_.modes, weights_[p].data());
   }
   auto nodeWeights = [&](Eigen::Index j, std::vector<double>& out) {
     std::vector<double> unit(u_.modes, 0.0);
     unit[j] = 1.0;
     out.assign(u_.modes, 0.0);
-    u_.sineSum(unit.data(), u_.modes, out.data());
+    u_.sineSum(*kernels_, unit.data(), u_.modes, out.data());
   };
   nodeWeights(last, lastNode_);
   nodeWeights(second, secondNode_);
@@ -62,7 +58,7 @@ void ModalTail::prepare(const NonlinearString& string, double k,
   if (v_.modes > 0) {
     std::vector<double> unit(v_.modes, 0.0);
     unit.back() = 1.0;
-    v_.sineSum(unit.data(), v_.modes, vEnd_.data());
+    v_.sineSum(*kernels_, unit.data(), v_.modes, vEnd_.data());
   }
   setCoefficients(string, 0.0, 0.0);
 }
@@ -119,10 +115,10 @@ void ModalTail::takeResidual() noexcept {
 
 void ModalTail::enter(const Vector& q, const Vector& qNext) noexcept {
   const int nu = u_.modes;
-  u_.sineSum(q.data(), u_.modes, u_.now());
-  u_.sineSum(qNext.data(), u_.modes, u_.next());
-  v_.sineSum(q.data() + nu, v_.modes, v_.now());
-  v_.sineSum(qNext.data() + nu, v_.modes, v_.next());
+  u_.sineSum(*kernels_, q.data(), u_.modes, u_.now());
+  u_.sineSum(*kernels_, qNext.data(), u_.modes, u_.next());
+  v_.sineSum(*kernels_, q.data() + nu, v_.modes, v_.now());
+  v_.sineSum(*kernels_, qNext.data() + nu, v_.modes, v_.next());
   u_.kept = u_.modes;
   v_.kept = v_.modes;
   probeAll();
@@ -151,10 +147,10 @@ void ModalTail::probeAll() noexcept {
 
 void ModalTail::leave(Vector& q, Vector& qNext) const noexcept {
   const int nu = u_.modes;
-  u_.sineSum(u_.now(), u_.kept, q.data());
-  u_.sineSum(u_.next(), u_.kept, qNext.data());
-  v_.sineSum(v_.now(), v_.kept, q.data() + nu);
-  v_.sineSum(v_.next(), v_.kept, qNext.data() + nu);
+  u_.sineSum(*kernels_, u_.now(), u_.kept, q.data());
+  u_.sineSum(*kernels_, u_.next(), u_.kept, qNext.data());
+  v_.sineSum(*kernels_, v_.now(), v_.kept, q.data() + nu);
+  v_.sineSum(*kernels_, v_.next(), v_.kept, qNext.data() + nu);
 }
 
 // The step writes level n + 2 over level n, which then takes the name of n + 1.

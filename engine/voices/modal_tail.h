@@ -30,7 +30,7 @@ class ModalTail {
   // bridge at w pushes the same nodes with −c1 w and −c2 w: a force along the pull's own weights.
   enum Probe { kPickup0, kPickup1, kPull, kContact, kProbes };
 
-  // Sizes the tables for this string's grids (may allocate): the sine tables, and the probes'
+  // Sizes the tables for this string's grids (may allocate): the transform's rows, and the probes'
   // modal weights from their node weights (kProbes spans of u's M − 1 values; kPull's is unused)
   // and the pull's nodes (q's indices of u_{M−1} and u_{M−2}). No pull until setPull().
   void prepare(const NonlinearString& string, double k,
@@ -74,20 +74,21 @@ class ModalTail {
 
  private:
   // One grid's modes: amplitudes at levels n and n + 1 (the two arrays take turns), the
-  // recursion's coefficients a^{n+2} = c1 a^{n+1} − c2 a^n, M⁻¹K and M⁻¹C of each mode, and the
-  // sine table sin(π t / M), t < 2M.
+  // recursion's coefficients a^{n+2} = c1 a^{n+1} − c2 a^n, and M⁻¹K and M⁻¹C of each mode.
   struct Grid {
     int modes = 0;  // M − 1
     int kept = 0;
     int newer = 1;      // levels[newer] holds n + 1, the other n
     double mass = 0.0;  // ρA h on this grid: M's diagonal
-    std::vector<double> levels[2], c1, c2, kappa, gamma, sines;
+    std::vector<double> levels[2], c1, c2, kappa, gamma;
+    std::vector<double> sinTheta, twoCos;  // of θ_i = π i / M, the transform's rows
     double* now() { return levels[1 - newer].data(); }
     double* next() { return levels[newer].data(); }
     const double* now() const { return levels[1 - newer].data(); }
     const double* next() const { return levels[newer].data(); }
     void prepare(int segments, double spacing, double rhoA);
-    void sineSum(const double* in, int terms, double* out) const noexcept;  // DST-I, M − 1 out
+    // DST-I of `terms` values into M − 1 (Kernels::sineSums).
+    void sineSum(const Kernels& kernels, const double* in, int terms, double* out) const noexcept;
     double modeEnergy(int m, double k, double sigma1) const noexcept;
   };
   void probeAll() noexcept;
