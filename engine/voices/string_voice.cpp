@@ -400,7 +400,7 @@ void StringVoice::reset() noexcept {
   active_ = struck_ = linear_ = steppedLinear_ = inModes_ = false;  // the copy is geometric
   parked_ = true;
   steps_ = stepsInModes_ = 0;
-  bridgeAt_ = bridgeBefore_ = 0.0;
+  bridgeAt_ = bridgeBefore_ = residualLeft_ = 0.0;
   modesDue_ = ModesDue::none;
   applyBend();  // the copy brought back β = 1
 }
@@ -486,6 +486,10 @@ void StringVoice::wake() noexcept {
 }
 
 bool StringVoice::stepOnBridge(double w, double out[2]) noexcept {
+  if (residualLeft_ != 0.0) {  // modes left since the last step (leaveModes)
+    injected_ += 0.5 * residualLeft_ * bridgeAt_ * w;
+    residualLeft_ = 0.0;
+  }
   bridgeBefore_ = bridgeAt_;
   bridgeAt_ = w;
   scheme_->setPointForce(0, coupling_.lastIndex(), coupling_.forceOnLast(w));
@@ -626,16 +630,18 @@ void StringVoice::enterModes() noexcept {
 }
 
 // The modes dropped come back at rest, and with them the coupling's full self-stiffness: the
-// coupling energy's change (½ residual w^n w^{n+1}) is counted as injected.
+// coupling energy gains ½ residual w^n w^{n+1}, counted as injected at the next step's start, where
+// the bridge's w^{n+1} is known (stepOnBridge), or at once where the step is starting.
 void StringVoice::leaveModes() noexcept {
-  const double before = energy() + couplingEnergy(bridgeBefore_, bridgeAt_);
+  const double before = energy();
   levelN_ = scheme_->q();  // the same size: no allocation
   levelNext_ = scheme_->qNext();
   modal_.leave(levelN_, levelNext_);
   scheme_->setLevels(levelN_, levelNext_, stepsInModes_);
   inModes_ = false;
   modesDue_ = ModesDue::none;
-  injected_ += energy() + couplingEnergy(bridgeBefore_, bridgeAt_) - before;
+  injected_ += energy() - before;
+  residualLeft_ += modal_.residual();
 }
 
 void StringVoice::changeModes() noexcept {
@@ -655,7 +661,11 @@ bool StringVoice::stepAndPick(double out[2]) noexcept {
     // The hammer parked below: should the string swing down onto it, the step is the scheme's,
     // with the felt's force, and the back-check meets the hammer as on the nodes.
     const double hammer = scheme_->q()[scheme_->system().hammerIndex()];
-    if (hammer - modal_.atNext(ModalTail::kContact) > 0.0) leaveModes();
+    if (hammer - modal_.atNext(ModalTail::kContact) > 0.0) {
+      leaveModes();
+      injected_ += 0.5 * residualLeft_ * bridgeBefore_ * bridgeAt_;
+      residualLeft_ = 0.0;
+    }
   }
   if (inModes_) {
     modal_.step(bridgeAt_);

@@ -253,6 +253,7 @@ class StringVoice {
   // The bridge's w of the last step and of the one before (stepOnBridge); 0 off a bridge: the
   // levels of the coupling's energy between two steps.
   double bridgeAt_ = 0.0, bridgeBefore_ = 0.0;
+  double residualLeft_ = 0.0;  // the modes' residual when they were left, until the next step
   // A change of the modes kept, made at the start of the next step, where the bridge's two levels
   // are known, so that the coupling energy it changes is counted.
   enum class ModesDue { none, truncate, restore } modesDue_ = ModesDue::none;
