@@ -34,10 +34,10 @@ class Player {
   static constexpr int kFloorVoices = 4;
   // Before a key is dropped, the tails (Synth::setLiveTail): kOverloadedBlocks blocks in a row
   // over kTailShare of the budget (0.6 of the period by default), with keys sounding, let the
-  // decaying strings go linear sooner, at about half their cost, their pitch off by at most 0.87
-  // cents, and hold any drop for kHoldSeconds; kTailRelief seconds in a row under kRelief give the
-  // strings not yet linear their preset's tail again. A new Player takes the synth's tail as off:
-  // one synth reused by several players must be set off between them.
+  // decaying strings go linear sooner, at a tenth to a fifth of their cost, their pitch off by at
+  // most 0.87 cents, and hold any drop for kHoldSeconds; kTailRelief seconds in a row under kRelief
+  // give the strings not yet linear their preset's tail again. A new Player takes the synth's tail
+  // as off: one synth reused by several players must be set off between them.
   static constexpr double kTailShare = 0.75;
   static constexpr double kTailRelief = 2.0;
 

@@ -83,10 +83,11 @@ class Synth {
   // in. So 0 and 127 are today's up and down to the bit, and 64 is a half pedal (contact 0.45).
   static double damperContact(int value) noexcept;
   // Every string key's live tail (StringVoice::setLiveTail): on, a decaying string goes linear at
-  // a tension modulation of 1e-3 rather than its preset's (1e-4 on grand-piano), at about half
-  // the cost a step, its pitch off by at most 0.87 cents. For a live player under load, before it
-  // drops keys (app::Player); renders never take it, so their output stays the preset's. Off: the
-  // strings not yet linear go on to the preset's threshold, the linear ones stay linear.
+  // a tension modulation of 1e-3 rather than its preset's (1e-4 on grand-piano), and steps its
+  // modes at a tenth to a fifth of the cost, its pitch off by at most 0.87 cents. For a live player
+  // under load, before it drops keys (app::Player); renders never take it, so their output stays
+  // the preset's. Off: the strings not yet linear go on to the preset's threshold, the linear ones
+  // stay linear.
   void setLiveTail(bool on) noexcept;
   bool liveTail() const { return liveTail_; }
   // The instrument playing now has strings whose tail the live tail moves (not a plate, nor a

@@ -46,20 +46,17 @@ void ModalTail::prepare(const NonlinearString& string, double k,
     weights_[p].assign(u_.modes, 0.0);
     if (p != kPull) u_.sineSum(*kernels_, probes[p].data(), u_.modes, weights_[p].data());
   }
-  auto nodeWeights = [&](Eigen::Index j, std::vector<double>& out) {
-    std::vector<double> unit(u_.modes, 0.0);
+  // φ_m(j) of every mode of a grid at its node j.
+  auto nodeWeights = [&](const Grid& g, Eigen::Index j, std::vector<double>& out) {
+    std::vector<double> unit(g.modes, 0.0);
+    out.assign(g.modes, 0.0);
+    if (g.modes == 0) return;
     unit[j] = 1.0;
-    out.assign(u_.modes, 0.0);
-    u_.sineSum(*kernels_, unit.data(), u_.modes, out.data());
+    g.sineSum(*kernels_, unit.data(), g.modes, out.data());
   };
-  nodeWeights(last, lastNode_);
-  nodeWeights(second, secondNode_);
-  vEnd_.assign(v_.modes, 0.0);
-  if (v_.modes > 0) {
-    std::vector<double> unit(v_.modes, 0.0);
-    unit.back() = 1.0;
-    v_.sineSum(*kernels_, unit.data(), v_.modes, vEnd_.data());
-  }
+  nodeWeights(u_, last, lastNode_);
+  nodeWeights(u_, second, secondNode_);
+  nodeWeights(v_, v_.modes - 1, vEnd_);
   setCoefficients(string, 0.0, 0.0);
 }
 

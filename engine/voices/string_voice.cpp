@@ -399,7 +399,7 @@ void StringVoice::reset() noexcept {
   quiet_.reset();
   active_ = struck_ = linear_ = steppedLinear_ = inModes_ = false;  // the copy is geometric
   parked_ = true;
-  steps_ = stepsInModes_ = 0;
+  stepsInModes_ = 0;
   bridgeAt_ = bridgeBefore_ = residualLeft_ = 0.0;
   modesDue_ = ModesDue::none;
   applyBend();  // the copy brought back β = 1
@@ -639,6 +639,7 @@ void StringVoice::leaveModes() noexcept {
   modal_.leave(levelN_, levelNext_);
   scheme_->setLevels(levelN_, levelNext_, stepsInModes_);
   inModes_ = false;
+  stepsInModes_ = 0;  // the scheme counts them now
   modesDue_ = ModesDue::none;
   injected_ += energy() - before;
   residualLeft_ += modal_.residual();
@@ -687,8 +688,8 @@ bool StringVoice::stepAndPick(double out[2]) noexcept {
     ready = decimators_[c].push(value, out[c]);
   }
   // After the pickups: the check changes what steps next, not this step's output.
-  ++steps_;
-  if (linearisable_ && steps_ % kLinearCheckSteps == 0) checkLinear();
+  if (linearisable_ && (scheme_->stepIndex() + stepsInModes_) % kLinearCheckSteps == 0)
+    checkLinear();
   return ready;
 }
 

@@ -128,9 +128,10 @@ class StringVoice {
   void setBend(double semitones) noexcept;
   // The live tail (the player under load, Synth::setLiveTail): the linear tail taken from a
   // tension modulation of kMaxLinearBelow (the pitch then off by at most 0.87 cents) where the
-  // preset sets less, so that decaying strings step the linear string sooner, at about half the
-  // cost. A preset without the tail (linear_below 0) keeps none. A string gone linear stays so
-  // when it ends (until struck, or over twice the threshold it went linear at).
+  // preset sets less, so that decaying strings step the linear string sooner, in their modes at
+  // a tenth to a fifth of the cost. A preset without the tail (linear_below 0) keeps none. A string
+  // gone linear stays so when it ends (until struck, or over twice the threshold it went linear
+  // at).
   void setLiveTail(bool on) noexcept { liveTail_ = on; }
   // The linear tail in the string's modes (modal_tail.h): on (the default), a linear string with no
   // felt damper on it steps its modes, the highest dropped while together they hold under `floor`
@@ -215,7 +216,7 @@ class StringVoice {
   void setLinear(bool on) noexcept;
   void prepareModes();
   void retuneModes() noexcept;
-  void enterModes() noexcept;  // where it may: linear, no damper on it, the modal tail on
+  void enterModes() noexcept;  // where it may: linear, no felt on it, the hammer parked, tail on
   void leaveModes() noexcept;
 
   StringPatch patch_;
@@ -247,9 +248,8 @@ class StringVoice {
   bool modalTail_ = true, inModes_ = false;
   double modalFloor_ = kModalFloor;
   double besideModes_ = 0.0;
-  long stepsInModes_ = 0;
+  long stepsInModes_ = 0;  // since entering: the scheme's own steps and these count the checks
   Vector levelN_, levelNext_;
-  long steps_ = 0;  // since reset(): the linear tail's check counts them
   // The bridge's w of the last step and of the one before (stepOnBridge); 0 off a bridge: the
   // levels of the coupling's energy between two steps.
   double bridgeAt_ = 0.0, bridgeBefore_ = 0.0;
