@@ -224,12 +224,47 @@ HAMILTONE_TARGET void linearUpdate(long n, const double* q, const double* qm, co
   linearUpdateOf<false, false>(n, q, qm, minv, kq, x, xScale, down, kk, invUp, qp);
 }
 
-HAMILTONE_TARGET void modalStep(long n, const double* c1, const double* c2, const double* const* w,
-                                double f, double* older, const double* newer, double out[4]) {
-  const double *w0 = w[0], *w1 = w[1], *w2 = w[2], *w3 = w[3];
-  double p0 = 0.0, p1 = 0.0, p2 = 0.0, p3 = 0.0;
-#pragma omp simd reduction(+ : p0, p1, p2, p3)
-  for (long m = 0; m < n; ++m) {
+// One vector register of doubles (GCC's vector extension, so that the product below is vectorised
+// along the rows as written, whatever the compiler's cost model).
+typedef double Lanes __attribute__((vector_size(kLanes * sizeof(double))));
+
+// A register's lanes summed as a tree: halves, then quarters, … (the order of every call on a
+// path).
+HAMILTONE_TARGET inline double laneSum(Lanes s) {
+  double lane[kLanes];
+  __builtin_memcpy(lane, &s, sizeof s);
+  for (int width = kLanes / 2; width > 0; width /= 2)
+    for (int i = 0; i < width; ++i) lane[i] += lane[i + width];
+  return lane[0];
+}
+
+HAMILTONE_TARGET inline Lanes loadLanes(const double* p) {
+  Lanes x;
+  __builtin_memcpy(&x, p, sizeof x);
+  return x;
+}
+
+// Whole registers, their sums kept as lanes and added once at the end; then the modes past the
+// last whole register one by one (none where the modes are padded to kMaxLanes, as ModalTail's).
+HAMILTONE_TARGET void modalStep(long n, const double* __restrict c1, const double* __restrict c2,
+                                const double* const* w, double f, double* __restrict older,
+                                const double* __restrict newer, double out[4]) {
+  const double* __restrict w0 = w[0], * __restrict w1 = w[1], * __restrict w2 = w[2], * __restrict w3 = w[3];
+  const Lanes force = Lanes{} + f;
+  Lanes s0 = {}, s1 = {}, s2 = {}, s3 = {};
+  long m = 0;
+  for (; m + kLanes <= n; m += kLanes) {
+    const Lanes pull = loadLanes(w2 + m);
+    const Lanes x = loadLanes(c1 + m) * loadLanes(newer + m) -
+                    loadLanes(c2 + m) * loadLanes(older + m) + force * pull;
+    __builtin_memcpy(older + m, &x, sizeof x);
+    s0 += loadLanes(w0 + m) * x;
+    s1 += loadLanes(w1 + m) * x;
+    s2 += pull * x;
+    s3 += loadLanes(w3 + m) * x;
+  }
+  double p0 = laneSum(s0), p1 = laneSum(s1), p2 = laneSum(s2), p3 = laneSum(s3);
+  for (; m < n; ++m) {
     const double x = c1[m] * newer[m] - c2[m] * older[m] + f * w2[m];
     older[m] = x;
     p0 += w0[m] * x;
@@ -240,9 +275,25 @@ HAMILTONE_TARGET void modalStep(long n, const double* c1, const double* c2, cons
   out[0] = p0, out[1] = p1, out[2] = p2, out[3] = p3;
 }
 
-// One vector register of doubles (GCC's vector extension, so that the product below is vectorised
-// along the rows as written, whatever the compiler's cost model).
-typedef double Lanes __attribute__((vector_size(kLanes * sizeof(double))));
+// modalStep with no force and one probe (v's modes).
+HAMILTONE_TARGET double freeModalStep(long n, const double* __restrict c1,
+                                      const double* __restrict c2, const double* __restrict w,
+                                      double* __restrict older, const double* __restrict newer) {
+  Lanes s = {};
+  long m = 0;
+  for (; m + kLanes <= n; m += kLanes) {
+    const Lanes x =
+        loadLanes(c1 + m) * loadLanes(newer + m) - loadLanes(c2 + m) * loadLanes(older + m);
+    __builtin_memcpy(older + m, &x, sizeof x);
+    s += loadLanes(w + m) * x;
+  }
+  double p = laneSum(s);
+  for (; m < n; ++m) {
+    older[m] = c1[m] * newer[m] - c2[m] * older[m];
+    p += w[m] * older[m];
+  }
+  return p;
+}
 
 // `Rows` registers of rows from row i on, side by side: each row's recurrence is a chain of a
 // product and a difference a step, so several run at once.
@@ -355,6 +406,7 @@ extern const Kernels kernels{.isa = HAMILTONE_KERNEL_ISA,
                              .savUpdate = savUpdate,
                              .linearUpdate = linearUpdate,
                              .modalStep = modalStep,
+                             .freeModalStep = freeModalStep,
                              .sineSums = sineSums,
                              .matrixProduct = matrixProduct,
                              .gridLaplacian = gridLaplacian,

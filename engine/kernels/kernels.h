@@ -68,9 +68,12 @@ struct Kernels {
   // The modal tail's step (voices/modal_tail.h) over n modes: x_m = c1_m newer_m − c2_m older_m
   // + f w[2]_m (w[2] the modal weights of the bridge's pull, along which its force acts, f that
   // force scaled to a mode's step), written over older; out[p] = Σ_m w[p]_m x_m for the four
-  // probes.
+  // probes, summed in vector registers (the order differs between paths).
   void (*modalStep)(long n, const double* c1, const double* c2, const double* const* w, double f,
                     double* older, const double* newer, double out[4]);
+  // The same with no force and one probe w (v's modes): returns Σ_m w_m x_m.
+  double (*freeModalStep)(long n, const double* c1, const double* c2, const double* w,
+                          double* older, const double* newer);
 
   // The modal tail's sine transform (DST-I, unnormalised): out_i = scale Σ_{t<terms} in_t
   // sin((t + 1) θ_i) for i < n, from sin θ_i and 2 cos θ_i (kMaxLanes values past n, finite),

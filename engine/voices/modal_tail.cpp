@@ -8,8 +8,10 @@ namespace hamiltone {
 void ModalTail::Grid::prepare(int segments, double spacing, double rhoA) {
   modes = kept = segments - 1;
   mass = rhoA * spacing;
-  for (std::vector<double>* x : {&levels[0], &levels[1], &c1, &c2, &kappa, &gamma})
-    x->assign(modes, 0.0);
+  // Past the modes, zeros to a whole register: recursions of 0 on 0 that stay 0.
+  for (std::vector<double>* x : {&levels[0], &levels[1], &c1, &c2})
+    x->assign(registers(modes), 0.0);
+  for (std::vector<double>* x : {&kappa, &gamma}) x->assign(modes, 0.0);
   sinTheta.assign(modes + kMaxLanes, 0.0);  // θ_i = π i / M, padded for the kernel's last lanes
   twoCos.assign(modes + kMaxLanes, 0.0);
   for (int i = 1; i <= modes; ++i) {
@@ -43,7 +45,7 @@ void ModalTail::prepare(const NonlinearString& string, double k,
   u_.prepare(string.segments(), string.spacing(), rhoA);
   v_.prepare(string.grid().longitudinal, string.longitudinalSpacing(), rhoA);
   for (int p = 0; p < kProbes; ++p) {
-    weights_[p].assign(u_.modes, 0.0);
+    weights_[p].assign(registers(u_.modes), 0.0);
     if (p != kPull) u_.sineSum(*kernels_, probes[p].data(), u_.modes, weights_[p].data());
   }
   // φ_m(j) of every mode of a grid at its node j.
@@ -57,6 +59,7 @@ void ModalTail::prepare(const NonlinearString& string, double k,
   nodeWeights(u_, last, lastNode_);
   nodeWeights(u_, second, secondNode_);
   nodeWeights(v_, v_.modes - 1, vEnd_);
+  vEnd_.resize(registers(v_.modes), 0.0);
   setCoefficients(string, 0.0, 0.0);
 }
 
@@ -156,18 +159,12 @@ void ModalTail::step(double w) noexcept {
   vLast_ = vLastNext_;
   const double* weights[kProbes];
   for (int p = 0; p < kProbes; ++p) weights[p] = weights_[p].data();
-  kernels_->modalStep(u_.kept, u_.c1.data(), u_.c2.data(), weights, -forceScale_ * w, u_.now(),
-                      u_.next(), next_.data());
+  kernels_->modalStep(registers(u_.kept), u_.c1.data(), u_.c2.data(), weights, -forceScale_ * w,
+                      u_.now(), u_.next(), next_.data());
   u_.newer = 1 - u_.newer;
-  double* older = v_.now();
-  const double *newer = v_.next(), *c1 = v_.c1.data(), *c2 = v_.c2.data(), *e = vEnd_.data();
-  double last = 0.0;
-  for (int m = 0; m < v_.kept; ++m) {
-    older[m] = c1[m] * newer[m] - c2[m] * older[m];
-    last += e[m] * older[m];
-  }
+  vLastNext_ = kernels_->freeModalStep(registers(v_.kept), v_.c1.data(), v_.c2.data(), vEnd_.data(),
+                                       v_.now(), v_.next());
   v_.newer = 1 - v_.newer;
-  vLastNext_ = last;
 }
 
 double ModalTail::energy() const noexcept {
@@ -183,11 +180,13 @@ double ModalTail::truncate(double floor) noexcept {
   if (budget <= 0.0) return dropped;
   for (Grid* g : {&u_, &v_}) {
     while (g->kept > 0) {
-      const double e = g->modeEnergy(g->kept - 1, k_, sigma1_);
+      const int from = (g->kept - 1) / kMaxLanes * kMaxLanes;  // the last register's first mode
+      double e = 0.0;
+      for (int m = from; m < g->kept; ++m) e += g->modeEnergy(m, k_, sigma1_);
       if (dropped + e >= budget) break;
       dropped += e;
-      --g->kept;
-      g->now()[g->kept] = g->next()[g->kept] = 0.0;
+      for (int m = from; m < g->kept; ++m) g->now()[m] = g->next()[m] = 0.0;
+      g->kept = from;
     }
   }
   probeAll();

@@ -7,10 +7,10 @@
 // is then one recursion per mode, the bridge's point forces f entering through φ_m at their nodes
 // and every output (a pickup, the bridge's end nodes, the hammer's contact) a dot product with
 // the modes. The modes whose energy together is under a floor of the string's (−100 dB) are
-// dropped, highest first; the rest step as before, and what the dropped ones gave statically under
-// the bridge's force stays in the coupling as a softer self-stiffness (residual()). The same linear
-// system, so its energy balance holds step by step (energy()), less what a drop removes (returned
-// by truncate()).
+// dropped, highest first and a vector register of them at a time; the rest step as before, and what
+// the dropped ones gave statically under the bridge's force stays in the coupling as a softer
+// self-stiffness (residual()). The same linear system, so its energy balance holds step by step
+// (energy()), less what a drop removes (returned by truncate()).
 #pragma once
 
 #include <array>
@@ -61,7 +61,10 @@ class ModalTail {
   // correction, ½ q^{n+1}ᵀ K q^n), J.
   double energy() const noexcept;
   // Drops the highest modes of u, then of v, while what they hold together stays under
-  // floor × energy() (none at a floor of 0); returns the energy dropped.
+  // floor × energy() (none at a floor of 0); returns the energy dropped. They go a register at a
+  // time (kMaxLanes modes, the last register's first), so that the kept modes fill whole registers
+  // or are all of them: the step then runs in whole registers, the padding past the last mode
+  // stepping zeros.
   double truncate(double floor) noexcept;
   // Takes every mode again, the dropped ones at rest (where a force may wake them: a strike of the
   // key's other strings).
@@ -76,11 +79,11 @@ class ModalTail {
   // One grid's modes: amplitudes at levels n and n + 1 (the two arrays take turns), the
   // recursion's coefficients a^{n+2} = c1 a^{n+1} − c2 a^n, and M⁻¹K and M⁻¹C of each mode.
   struct Grid {
-    int modes = 0;  // M − 1
-    int kept = 0;
+    int modes = 0;      // M − 1
+    int kept = 0;       // all the modes, or a multiple of kMaxLanes
     int newer = 1;      // levels[newer] holds n + 1, the other n
     double mass = 0.0;  // ρA h on this grid: M's diagonal
-    std::vector<double> levels[2], c1, c2, kappa, gamma;
+    std::vector<double> levels[2], c1, c2, kappa, gamma;  // the first three to registers(modes)
     std::vector<double> sinTheta, twoCos;  // of θ_i = π i / M, the transform's rows
     double* now() { return levels[1 - newer].data(); }
     double* next() { return levels[newer].data(); }
@@ -91,6 +94,8 @@ class ModalTail {
     void sineSum(const Kernels& kernels, const double* in, int terms, double* out) const noexcept;
     double modeEnergy(int m, double k, double sigma1) const noexcept;
   };
+  // n modes and the padding to a whole register.
+  static int registers(int n) { return (n + kMaxLanes - 1) / kMaxLanes * kMaxLanes; }
   void probeAll() noexcept;
   void takeResidual() noexcept;
 
@@ -98,7 +103,8 @@ class ModalTail {
   Grid u_, v_;
   double k_ = 0.0, sigma1_ = 0.0;
   double forceScale_ = 0.0;  // k² / (ρA h (1 + σ0k)): a force's share of a mode's step
-  // The probes' modal weights, the pull's nodes', and v's last node's.
+  // The probes' modal weights (to registers(u's modes)), the pull's nodes', and v's last node's
+  // (to registers(v's modes)).
   std::array<std::vector<double>, kProbes> weights_;
   std::vector<double> lastNode_, secondNode_, vEnd_;
   std::array<double, kProbes> now_{}, next_{};

@@ -236,11 +236,12 @@ TEST(Kernels, SchemeSumsAgreeWithinTheirReorderingBound) {
 }
 
 // The modal tail's step (voices/modal_tail.h): the recursion element by element, the same bits on
-// every path as written out; the four probes' sums within their reordering bound.
+// every path as written out; the four probes' sums within their reordering bound; and v's, with
+// no force and one probe.
 TEST(Kernels, TheModalStepIsTheRecursionOnEveryPath) {
   std::vector<const Kernels*> paths = otherPaths();
   paths.push_back(&kernelsFor(Isa::portable));
-  for (long n : {1L, 3L, 8L, 13L, 120L}) {
+  for (long n : {1L, 3L, 8L, 13L, 16L, 120L}) {
     const std::vector<double> c1 = randomArray(n, 2.0, 3), c2 = randomArray(n, 1.0, 4),
                               newer = randomArray(n, 1e-4, 5), older = randomArray(n, 1e-4, 6);
     std::vector<std::vector<double>> w;
@@ -263,6 +264,18 @@ TEST(Kernels, TheModalStepIsTheRecursionOnEveryPath) {
         for (long m = 0; m < n; ++m) sum += w[p][m] * expected[m];
         EXPECT_NEAR(out[p], sum, n * 1.2e-16 * bound[p]) << path->name << " probe " << p;
       }
+      // v's modes: no force, the first probe alone.
+      std::vector<double> free = older, freeExpected(n);
+      double freeSum = 0.0, freeBound = 0.0;
+      for (long m = 0; m < n; ++m) {
+        freeExpected[m] = c1[m] * newer[m] - c2[m] * older[m];
+        freeSum += w[0][m] * freeExpected[m];
+        freeBound += std::abs(w[0][m] * freeExpected[m]);
+      }
+      const double last =
+          path->freeModalStep(n, c1.data(), c2.data(), w[0].data(), free.data(), newer.data());
+      EXPECT_EQ(free, freeExpected) << path->name << " n = " << n;
+      EXPECT_NEAR(last, freeSum, n * 1.2e-16 * freeBound) << path->name << " n = " << n;
     }
   }
 }
