@@ -573,7 +573,8 @@ double StringVoice::pickup(const Vector& q, const Vector& qNext, const PickupTap
 // changes the energy by what ψ held less the quadratic part, counted with what the strikes put
 // in. Checked at fixed step counts, so the output does not depend on the block size. A linear
 // string with no felt damper on it then steps its modes, the highest of them dropped as they fall
-// under kModalFloor of its energy (what they held counted as removed) at the next step's start.
+// under kModalFloor of its energy (kLiveModalFloor under the live tail; what they held counted as
+// removed) at the next step's start.
 void StringVoice::checkLinear() noexcept {
   const NonlinearString& string = scheme_->system().string();
   const StringPhysics& p = string.physics();
@@ -648,7 +649,8 @@ void StringVoice::leaveModes() noexcept {
 void StringVoice::changeModes() noexcept {
   const double before = couplingEnergy(bridgeBefore_, bridgeAt_);
   if (modesDue_ == ModesDue::truncate)
-    caught_ += modal_.truncate(modalFloor_);
+    caught_ += modal_.truncate(
+        liveTail_ && modalFloor_ > 0.0 ? std::max(modalFloor_, kLiveModalFloor) : modalFloor_);
   else
     modal_.restore();
   injected_ += couplingEnergy(bridgeBefore_, bridgeAt_) - before;

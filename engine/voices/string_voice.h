@@ -69,6 +69,9 @@ constexpr double kMaxLinearBelow = 1e-3;
 // The modal tail's floor: the highest modes of a linear string are dropped while together they hold
 // under this share of its energy (−100 dB), checked every kLinearCheckSteps steps.
 constexpr double kModalFloor = 1e-10;
+// The floor under the live tail (the player under load): −80 dB, the dropped modes a part in 1e4 of
+// the string's output under its own partials, where the alternative is dropping a whole key.
+constexpr double kLiveModalFloor = 1e-8;
 // The most a string is detuned from its note, cents: its unison spread and its bridge's load.
 constexpr double kMaxDetuneCents = 50.0;
 
@@ -129,9 +132,10 @@ class StringVoice {
   // The live tail (the player under load, Synth::setLiveTail): the linear tail taken from a
   // tension modulation of kMaxLinearBelow (the pitch then off by at most 0.87 cents) where the
   // preset sets less, so that decaying strings step the linear string sooner, in their modes at
-  // a tenth to a fifth of the cost. A preset without the tail (linear_below 0) keeps none. A string
-  // gone linear stays so when it ends (until struck, or over twice the threshold it went linear
-  // at).
+  // a tenth to a fifth of the cost, and the modes' floor kLiveModalFloor where the string's is
+  // lower (not 0: every mode kept stays so). A preset without the tail (linear_below 0) keeps
+  // none. A string gone linear stays so when it ends (until struck, or over twice the threshold it
+  // went linear at).
   void setLiveTail(bool on) noexcept { liveTail_ = on; }
   // The linear tail in the string's modes (modal_tail.h): on (the default), a linear string with no
   // felt damper on it steps its modes, the highest dropped while together they hold under `floor`

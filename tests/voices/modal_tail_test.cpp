@@ -169,12 +169,49 @@ TEST(ModalTail, DropsOnlyWhatLiesUnderItsFloor) {
   EXPECT_GT(floored.removedEnergy(), every.removedEnergy());
 }
 
+// Under the live tail (the player under load) the floor is −80 dB: C2 with the live tail, against
+// the same with every mode kept, 1 s into its modes. It keeps fewer modes than the −100 dB floor
+// would keep of the same string now (40 and 48 of 224), and its output is that of all its modes
+// within 1e-3 of the tail's peak (1.1e-4): a part in 1e4 of the amplitude per drop, summed over
+// the drops and both pickups, as the −100 dB floor's is within 2e-5 above. Every mode kept (a
+// floor of 0) stays so under the live tail.
+TEST(ModalTail, UnderLoadItsFloorIsMinus80dB) {
+  StringVoice live, every;
+  for (StringVoice* v : {&live, &every}) {
+    v->prepare(piano(36), 36, kRate);
+    v->setLiveTail(true);
+    v->noteOn(0.5);
+  }
+  every.setModalTail(true, 0.0);
+  std::vector<double> a, b;
+  ASSERT_TRUE(untilModal(live, every, a, b));
+  const size_t switched = a.size();
+  for (int i = 0; i < 1 * 750; ++i) {
+    block(live, a);
+    block(every, b);
+  }
+  ASSERT_TRUE(live.inModes());
+  const int modes = live.segments() - 1;
+  EXPECT_EQ(every.modalTail().keptTransverse(), modes);
+  ModalTail quieter = every.modalTail();
+  quieter.truncate(kModalFloor);
+  const int kept = live.modalTail().keptTransverse();
+  const double difference = largestDifference(a, b, switched) / peak(b, switched);
+  std::printf(
+      "C2 live, 1 s into its modes: %d of %d modes kept (%d at -100 dB); output within "
+      "%.2e of all modes'\n",
+      kept, modes, quieter.keptTransverse(), difference);
+  EXPECT_LT(kept, quieter.keptTransverse());
+  EXPECT_LE(difference, 1e-3);
+}
+
 // On a key's bridge the floor drops modes that the bridge's force holds statically: C2's three
-// strings with the live tail's threshold, the floor on against every mode kept, 1 to 4 s into
-// their tails. Without their static give (ModalTail::residual()) the dropped modes stiffened each
-// string's end by up to 4e4 N/m against the bridge's 1.1e5, and the key's output moved by 2.5e-2
-// of its peak here; with it, by 2.7e-5: what is left is the dropped modes' dynamics, which lie
-// octaves above where the bridge moves. The bound, 1e-3, is 25 times under the error without it.
+// strings with the live tail (its threshold and its −80 dB floor), the floor on against every mode
+// kept, 1 to 4 s into their tails. Without their static give (ModalTail::residual()) the dropped
+// modes stiffen each string's end (by up to 4e4 N/m against the bridge's 1.1e5 at the −100 dB
+// floor), and the key's output moved by 1.2e-1 of its peak here (2.5e-2 at −100 dB); with it, by
+// 3.7e-4 (2.7e-5): what is left is the dropped modes' dynamics, which lie octaves above where the
+// bridge moves. The bound, 1e-3, is over a hundred times under the error without it.
 TEST(ModalTail, OnTheBridgeTheDroppedModesKeepTheirStaticGive) {
   const Instrument piano = loadPreset(HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml");
   UnisonStrings floored, every;
