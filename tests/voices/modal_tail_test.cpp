@@ -68,6 +68,19 @@ bool untilModal(StringVoice& modal, StringVoice& nodal, std::vector<double>& a,
   return modal.inModes();
 }
 
+// untilModal, then `seconds` more of both; returns where in a and b `modal` went into its modes,
+// or 0 if it never did.
+size_t modalFor(StringVoice& modal, StringVoice& nodal, std::vector<double>& a,
+                std::vector<double>& b, int seconds) {
+  if (!untilModal(modal, nodal, a, b)) return 0;
+  const size_t switched = a.size();
+  for (int i = 0; i < seconds * 750; ++i) {
+    block(modal, a);
+    block(nodal, b);
+  }
+  return switched;
+}
+
 // `voice` prepared with `patch` for `note`, struck at `velocity` and played until it steps its
 // modes; false if it never does within 10 s.
 bool struckIntoModes(StringVoice& voice, const StringPatch& patch, int note, double velocity) {
@@ -153,12 +166,8 @@ TEST(ModalTail, DropsOnlyWhatLiesUnderItsFloor) {
   floored.noteOn(0.5);
   every.noteOn(0.5);
   std::vector<double> a, b;
-  ASSERT_TRUE(untilModal(floored, every, a, b));
-  const size_t switched = a.size();
-  for (int i = 0; i < 3 * 750; ++i) {
-    block(floored, a);
-    block(every, b);
-  }
+  const size_t switched = modalFor(floored, every, a, b, 3);
+  ASSERT_GT(switched, 0u);
   ASSERT_TRUE(floored.inModes());
   const int kept = floored.modalTail().keptTransverse(), modes = floored.segments() - 1;
   const double difference = largestDifference(a, b, switched) / peak(b, switched);
@@ -184,12 +193,8 @@ TEST(ModalTail, UnderLoadItsFloorIsMinus80dB) {
   }
   every.setModalTail(true, 0.0);
   std::vector<double> a, b;
-  ASSERT_TRUE(untilModal(live, every, a, b));
-  const size_t switched = a.size();
-  for (int i = 0; i < 1 * 750; ++i) {
-    block(live, a);
-    block(every, b);
-  }
+  const size_t switched = modalFor(live, every, a, b, 1);
+  ASSERT_GT(switched, 0u);
   ASSERT_TRUE(live.inModes());
   const int modes = live.segments() - 1;
   EXPECT_EQ(every.modalTail().keptTransverse(), modes);
