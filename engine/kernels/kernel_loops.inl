@@ -224,8 +224,8 @@ HAMILTONE_TARGET void linearUpdate(long n, const double* q, const double* qm, co
   linearUpdateOf<false, false>(n, q, qm, minv, kq, x, xScale, down, kk, invUp, qp);
 }
 
-// One vector register of doubles (GCC's vector extension, so that the product below is vectorised
-// along the rows as written, whatever the compiler's cost model).
+// One vector register of doubles (GCC's vector extension, so that the loops below are vectorised
+// as written, whatever the compiler's cost model).
 typedef double Lanes __attribute__((vector_size(kLanes * sizeof(double))));
 
 // A register's lanes summed as a tree: halves, then quarters, … (the order of every call on a

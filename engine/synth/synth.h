@@ -92,7 +92,7 @@ class Synth {
   void setLiveTail(bool on) noexcept;
   bool liveTail() const { return liveTail_; }
   // The instrument playing now has strings whose tail the live tail moves (not a plate, nor a
-  // preset with linear_below 0 or at the bound already, nor the transverse grid).
+  // preset with linear_below 0, nor the transverse grid).
   bool takesLiveTail() const { return takesLiveTail_[program_] != 0; }
   // How a note-off's release velocity scales its damper's T60: 2^((64 − v)/63) — a key let go
   // fast (127) damps in half the time, a slow one (1) in twice, 64 as the preset says; 0 (no

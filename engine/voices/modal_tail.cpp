@@ -115,6 +115,11 @@ void ModalTail::takeResidual() noexcept {
 
 void ModalTail::enter(const Vector& q, const Vector& qNext) noexcept {
   const int nu = u_.modes;
+  // The padding at zero again: a non-finite force (a runaway the guard then resets) leaves
+  // 0 · ∞ there, which the probes would read.
+  for (Grid* g : {&u_, &v_})
+    for (std::vector<double>& level : g->levels)
+      std::fill(level.begin() + g->modes, level.end(), 0.0);
   u_.sineSum(*kernels_, q.data(), u_.modes, u_.now());
   u_.sineSum(*kernels_, qNext.data(), u_.modes, u_.next());
   v_.sineSum(*kernels_, q.data() + nu, v_.modes, v_.now());

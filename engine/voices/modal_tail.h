@@ -6,8 +6,9 @@
 //   (1 + σ0k) q^{n+1} = (2 − k²M⁻¹K − 2σ1k M⁻¹C) q^n − (1 − σ0k − 2σ1k M⁻¹C) q^{n−1} + k²M⁻¹f
 // is then one recursion per mode, the bridge's point forces f entering through φ_m at their nodes
 // and every output (a pickup, the bridge's end nodes, the hammer's contact) a dot product with
-// the modes. The modes whose energy together is under a floor of the string's (−100 dB) are
-// dropped, highest first and a vector register of them at a time; the rest step as before, and what
+// the modes. The modes whose energy together is under a floor of the string's (−100 dB, −80 dB
+// under the live tail) are dropped, highest first and a vector register of them at a time (the
+// arrays padded with zeros to whole registers); the rest step as before, and what
 // the dropped ones gave statically under the bridge's force stays in the coupling as a softer
 // self-stiffness (residual()). The same linear system, so its energy balance holds step by step
 // (energy()), less what a drop removes (returned by truncate()).
@@ -62,9 +63,9 @@ class ModalTail {
   double energy() const noexcept;
   // Drops the highest modes of u, then of v, while what they hold together stays under
   // floor × energy() (none at a floor of 0); returns the energy dropped. They go a register at a
-  // time (kMaxLanes modes, the last register's first), so that the kept modes fill whole registers
-  // or are all of them: the step then runs in whole registers, the padding past the last mode
-  // stepping zeros.
+  // time (kMaxLanes modes; first the last register, partly filled where the modes are not a whole
+  // number of registers), so that the kept modes fill whole registers or are all of them: the step
+  // then runs in whole registers, the padding past the last mode stepping zeros.
   double truncate(double floor) noexcept;
   // Takes every mode again, the dropped ones at rest (where a force may wake them: a strike of the
   // key's other strings).

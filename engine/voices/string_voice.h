@@ -144,8 +144,12 @@ class StringVoice {
   void setModalTail(bool on, double floor = kModalFloor) noexcept;
   bool inModes() const { return inModes_; }  // stepping its modes now
   const ModalTail& modalTail() const { return modal_; }
-  // The live tail changes something: the string takes the linear tail, below kMaxLinearBelow.
-  bool takesLiveTail() const { return linearisable_ && patch_.linearBelow < kMaxLinearBelow; }
+  // The live tail changes something: the string takes the linear tail, below kMaxLinearBelow, or
+  // drops its modes under a floor lower than kLiveModalFloor (not 0).
+  bool takesLiveTail() const {
+    return linearisable_ && (patch_.linearBelow < kMaxLinearBelow ||
+                             (modalTail_ && modalFloor_ > 0.0 && modalFloor_ < kLiveModalFloor));
+  }
   // Where the voice counts as silent and frees itself (QuietDetector::setFloor): in its output
   // units, negative for never. The default, QuietDetector::kFloor, is −100 dB under unit output.
   void setQuietFloor(double floor) noexcept { quiet_.setFloor(floor); }

@@ -31,19 +31,22 @@ using testing::Take;
 
 constexpr double kRate = testing::kTakeRate;
 
-// The live tail moves something only where strings take the linear tail below its bound: the
-// piano keys (linear_below 1e-4 by default); not a plate, nor keys whose preset says 0 (never
-// linear) or already 1e-3. It follows the instrument a program change chooses.
+// The live tail moves something only where strings take the linear tail: the piano keys
+// (linear_below 1e-4 by default), and keys already at its bound of 1e-3, whose modes it drops
+// under −80 dB rather than −100; not a plate, nor keys whose preset says 0 (never linear). It
+// follows the instrument a program change chooses.
 TEST(Synth, TakesTheLiveTailOnlyWhereAStringsTailWouldMove) {
   Instrument never = pianoKeys(60, 61), atBound = pianoKeys(60, 61);
   for (StringKey& key : never.keys) key.patch.linearBelow = 0.0;
   for (StringKey& key : atBound.keys) key.patch.linearBelow = kMaxLinearBelow;
   Synth synth = prepared({pianoKeys(60, 61), smallPlate(), never, atBound});
   EXPECT_TRUE(synth.takesLiveTail());
-  for (int program : {1, 2, 3}) {
+  for (int program : {1, 2}) {
     synth.handle({0xC0, static_cast<uint8_t>(program), 0});
     EXPECT_FALSE(synth.takesLiveTail()) << "program " << program;
   }
+  synth.handle({0xC0, 3, 0});
+  EXPECT_TRUE(synth.takesLiveTail());
   synth.handle({0xC0, 0, 0});
   EXPECT_TRUE(synth.takesLiveTail());
 }

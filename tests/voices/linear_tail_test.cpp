@@ -214,6 +214,10 @@ TEST(LinearTail, TheLiveTailTakesTheLargestThresholdAndLeavesALinearStringSo) {
   EXPECT_FALSE(ever);
   EXPECT_FALSE(never.takesLiveTail());
   EXPECT_TRUE(live.takesLiveTail());
+  // At the bound the live tail still drops the modes under −80 dB; with every mode kept, nothing.
+  EXPECT_TRUE(atBound.takesLiveTail());
+  atBound.setModalTail(true, 0.0);
+  EXPECT_FALSE(atBound.takesLiveTail());
 }
 
 // The end tension a bridge reads after a step (UnisonStrings) is the step's own: the geometric
