@@ -18,7 +18,8 @@
 // key at once every 0.5 s, the worst case. The same 64 keys with the strings' live tail on
 // (sustained_live_tail/…, Synth::setLiveTail), as the player turns it on under load before it
 // drops a key: the decaying strings go linear at a tension modulation of 1e-3, not the preset's
-// 1e-4.
+// 1e-4, and drop their modes under −80 dB, not −100 dB. Their tables give what a strike adds to
+// its buffer: the mean of the buffers with one less the others' (counter strike_%).
 //
 // --blocks=N sets the buffers timed per run (default 1000, the fewest a 99.9th percentile needs).
 #include <benchmark/benchmark.h>
@@ -134,7 +135,8 @@ class Rig {
     const std::int64_t nowNs = std::llround((block_ + 1) * period * 1e9);
     const std::int64_t arrival = nowNs - std::llround(period * 1e9);  // the block's first sample
     if (block_ == 0 && playing_.pedal) midi_.push({arrival, {0xB0, 64, 127}});
-    if (block_++ % restrike_ == 0) {
+    struck_ = block_++ % restrike_ == 0;
+    if (struck_) {
       const size_t n = playing_.keys.size();
       const size_t group = playing_.group > 0 ? static_cast<size_t>(playing_.group) : n;
       for (size_t i = 0; i < group; ++i) {
@@ -151,6 +153,7 @@ class Rig {
   }
 
   int sounding() const { return synth_.activeVoices(); }
+  bool struck() const { return struck_; }  // the last buffer had keys struck at its start
   int inModes() const { return synth_.stringsInModes(); }
   bool allSounding() const {
     return synth_.activeVoices() == static_cast<int>(playing_.keys.size());
@@ -160,6 +163,7 @@ class Rig {
   Playing playing_;
   int frames_;
   long restrike_, block_ = 0;
+  bool struck_ = false;
   size_t strikes_ = 0;
   Synth synth_;
   SpscQueue<app::StampedMessage> midi_{app::MidiInput::kQueueSize};
@@ -201,10 +205,14 @@ void callback(benchmark::State& state, const Playing& playing, int frames) {
   std::vector<double> seconds(static_cast<size_t>(blocks));
   size_t i = 0;
   double sounding = 0.0, inModes = 0.0;
+  double struck[2] = {}, count[2] = {};  // the buffers without a strike, and with
   for (auto _ : state) {
-    seconds[i++] = rig.render();
+    const double s = rig.render();
+    seconds[i++] = s;
     sounding += rig.sounding();
     inModes += rig.inModes();
+    struck[rig.struck()] += s;
+    ++count[rig.struck()];
   }
   // Struck in turn, the top keys (no dampers, T60s of a second or two) may fall silent and free
   // themselves between their strikes, as in playing; the chords must all keep sounding.
@@ -221,6 +229,9 @@ void callback(benchmark::State& state, const Playing& playing, int frames) {
   state.counters["p99_%"] = 100.0 * t.p99 / period;
   state.counters["p99.9_%"] = 100.0 * t.p999 / period;
   state.counters["max_%"] = 100.0 * t.max / period;
+  // What a strike adds to its buffer: the mean of the buffers with one over the others'.
+  if (count[0] > 0 && count[1] > 0)
+    state.counters["strike_%"] = 100.0 * (struck[1] / count[1] - struck[0] / count[0]) / period;
 }
 
 // Steps the polyphony up from 1 key until the 99.9th percentile reaches 70 % of the period;
@@ -242,7 +253,9 @@ std::string poolName(int frames, int keys, const char* kind = "pool") {
 void printRow(int keys, int frames, const benchmark::UserCounters& c, bool sounding = false) {
   std::printf("| %d | %d | %.0f %% | %.0f %% | %.0f %% | %.0f %% |", keys, frames,
               c.at("p50_%").value, c.at("p99_%").value, c.at("p99.9_%").value, c.at("max_%").value);
-  if (sounding) std::printf(" %.1f | %.1f |", c.at("sounding").value, c.at("in_modes").value);
+  if (sounding)
+    std::printf(" %.1f | %.1f | %+.0f %% |", c.at("sounding").value, c.at("in_modes").value,
+                c.at("strike_%").value);
   std::printf("\n");
 }
 
@@ -271,9 +284,10 @@ void printPoolTable(const RecordingReporter& reporter) {
       std::printf(
           "\ngrand-piano keys spread from A0 to C8 all sounding, pedal down, 8 struck every 0.5 s "
           "in turn, after 8 s, on %d thread%s (%d buffers per run; the mean of the keys sounding "
-          "and of their strings stepping their modes in the last columns)\n\n"
-          "| keys | frames | p50 | p99 | p99.9 | max | sounding | strings in modes |\n"
-          "|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+          "and of their strings stepping their modes, and what a strike adds to its buffer's mean, "
+          "in the last columns)\n\n"
+          "| keys | frames | p50 | p99 | p99.9 | max | sounding | strings in modes | a strike |\n"
+          "|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
           poolThreads, poolThreads == 1 ? "" : "s", blocks);
       header = true;
     }
@@ -283,8 +297,8 @@ void printPoolTable(const RecordingReporter& reporter) {
           reporter.find(poolName(kSustainedFrames, kLiveTailKeys, "sustained_live_tail"))) {
     std::printf(
         "\nthe same %d keys with the strings' live tail on (the player's first step under "
-        "load)\n\n| keys | frames | p50 | p99 | p99.9 | max | sounding | strings in modes |\n"
-        "|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+        "load)\n\n| keys | frames | p50 | p99 | p99.9 | max | sounding | strings in modes | a "
+        "strike |\n|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
         kLiveTailKeys);
     printRow(kLiveTailKeys, kSustainedFrames, r->counters, true);
   }
