@@ -346,6 +346,36 @@ double NonlinearString::oneCellGradient(const Vector& q, Vector& grad) const {
   return cellsPotential(cell.strain * cell.strain);
 }
 
+void NonlinearString::quasiStaticStretch(const Vector& q, const Vector& qNext,
+                                         double* v) const noexcept {
+  const Eigen::Index m = segments_, mv = grid_.longitudinal;
+  if (mv < 2) return;
+  const double invH = 1.0 / h_;
+  auto slope = [&](const Vector& x, Eigen::Index l) {  // ζ_l, u_0 = u_M = 0
+    const double left = l == 0 ? 0.0 : x[l - 1], right = l == m - 1 ? 0.0 : x[l];
+    return (right - left) * invH;
+  };
+  double* z = cell1_.data();
+  double mean = 0.0;
+  for (Eigen::Index j = 0; j < mv; ++j) {
+    double sum = 0.0;
+    for (Eigen::Index l = j * ratio_; l < (j + 1) * ratio_; ++l) {
+      const double a = slope(q, l), b = slope(qNext, l);
+      sum += 0.5 * (a * a + b * b);
+    }
+    z[j] = sum / ratio_;
+    mean += z[j];
+  }
+  mean /= static_cast<double>(mv);
+  const double ea = physics_.young * physics_.area;
+  const double scale = -(ea - physics_.tension) / (2.0 * ea);
+  double position = 0.0;
+  for (Eigen::Index j = 0; j < mv - 1; ++j) {
+    position += hv_ * scale * (z[j] - mean);  // v_{J+1} = v_J + h_v η_J
+    v[j] = position;
+  }
+}
+
 // V' = (EA − T0)/2 Σ_J h_v ε_J², from Σ_J ε_J².
 double NonlinearString::cellsPotential(double squaredStrains) const {
   return 0.5 * hv_ * (physics_.young * physics_.area - physics_.tension) * squaredStrains;

@@ -389,6 +389,7 @@ void StringVoice::prepareModes() {
   modal_.prepare(system.string(), k_, probes, coupling.lastIndex(), coupling.secondIndex());
   levelN_.setZero(system.size());
   levelNext_.setZero(system.size());
+  stretch_.setZero(std::max(system.string().grid().longitudinal - 1, 0));
 }
 
 void StringVoice::reset() noexcept {
@@ -596,6 +597,7 @@ void StringVoice::checkLinear() noexcept {
 void StringVoice::setLinear(bool on) noexcept {
   if (!on && inModes_) leaveModes();
   const double before = energy();
+  if (on) releaseStretch();
   scheme_->system().string().setLinearised(on);
   if (on)
     scheme_->dropPart(0);
@@ -604,6 +606,22 @@ void StringVoice::setLinear(bool on) noexcept {
   scheme_->stiffnessChanged();
   injected_ += energy() - before;
   linear_ = on;
+}
+
+// Going linear, v lets go of the stretch u's slopes held in it (quasiStaticStretch): the linear
+// string's u and v are apart, so that stretch would ring at v's own modes and pull the bridge at
+// them; the geometric string's follows u down. The same shift at both levels, v's velocity kept;
+// the energy it takes is counted with the switch's.
+void StringVoice::releaseStretch() noexcept {
+  const NonlinearString& string = scheme_->system().string();
+  const Eigen::Index nu = string.transverseSize(), nv = string.grid().longitudinal - 1;
+  if (nv < 1) return;
+  levelN_ = scheme_->q();
+  levelNext_ = scheme_->qNext();
+  string.quasiStaticStretch(levelN_, levelNext_, stretch_.data());
+  levelN_.segment(nu, nv) -= stretch_;
+  levelNext_.segment(nu, nv) -= stretch_;
+  scheme_->setLevels(levelN_, levelNext_, 0);
 }
 
 void StringVoice::setModalTail(bool on, double floor) noexcept {

@@ -222,6 +222,7 @@ class StringVoice {
   void changeModes() noexcept;  // the modes kept: dropped or restored, as modesDue_ says
   void checkLinear() noexcept;  // every kLinearCheckSteps steps
   void setLinear(bool on) noexcept;
+  void releaseStretch() noexcept;
   void prepareModes();
   void retuneModes() noexcept;
   void enterModes() noexcept;  // where it may: linear, no felt on it, the hammer parked, tail on
@@ -258,6 +259,7 @@ class StringVoice {
   double besideModes_ = 0.0;
   long stepsInModes_ = 0;  // since entering: the scheme's own steps and these count the checks
   Vector levelN_, levelNext_;
+  Vector stretch_;  // v's quasi-static stretch at the switch to linear (releaseStretch)
   // The bridge's w of the last step and of the one before (stepOnBridge); 0 off a bridge: the
   // levels of the coupling's energy between two steps.
   double bridgeAt_ = 0.0, bridgeBefore_ = 0.0;
