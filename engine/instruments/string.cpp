@@ -346,8 +346,7 @@ double NonlinearString::oneCellGradient(const Vector& q, Vector& grad) const {
   return cellsPotential(cell.strain * cell.strain);
 }
 
-void NonlinearString::quasiStaticStretch(const Vector& q, const Vector& qNext,
-                                         double* v) const noexcept {
+void NonlinearString::quasiStaticStretch(const Vector& q, double* v) const noexcept {
   const Eigen::Index m = segments_, mv = grid_.longitudinal;
   if (mv < 2) return;
   const double invH = 1.0 / h_;
@@ -360,8 +359,8 @@ void NonlinearString::quasiStaticStretch(const Vector& q, const Vector& qNext,
   for (Eigen::Index j = 0; j < mv; ++j) {
     double sum = 0.0;
     for (Eigen::Index l = j * ratio_; l < (j + 1) * ratio_; ++l) {
-      const double a = slope(q, l), b = slope(qNext, l);
-      sum += 0.5 * (a * a + b * b);
+      const double zeta = slope(q, l);
+      sum += zeta * zeta;
     }
     z[j] = sum / ratio_;
     mean += z[j];

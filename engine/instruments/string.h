@@ -116,9 +116,9 @@ class NonlinearString {
   // The stretch u's slopes hold in v at small amplitude, which the linear string no longer holds:
   // v where the tension is uniform along the string, η_J = −(EA − T0)/(2EA) (Z_J − Z̄) (from
   // T0 η + (EA − T0)(η + Z/2) the same in every cell, ε ≈ η + Z/2), Z_J the cell's mean square
-  // slope at q^{n+½} = (q + qNext)/2 read as the mean of Z_J at both levels, Z̄ their mean over the
-  // cells (v = 0 at both ends). Into v's Mv − 1 nodes; nothing with one coarse cell. No allocation.
-  void quasiStaticStretch(const Vector& q, const Vector& qNext, double* v) const noexcept;
+  // slope at q, Z̄ their mean over the cells (v = 0 at both ends). Into v's Mv − 1 nodes; nothing
+  // with one coarse cell. No allocation.
+  void quasiStaticStretch(const Vector& q, double* v) const noexcept;
   // The bound (44) for the linear string: v's block at EA. Where v's grid does not resolve the
   // longitudinal wave (c_L k > h_v, the transverse grid) it is shorter than a step there.
   double linearisedMaxStableStep(double sigma1) const;

@@ -610,17 +610,18 @@ void StringVoice::setLinear(bool on) noexcept {
 
 // Going linear, v lets go of the stretch u's slopes held in it (quasiStaticStretch): the linear
 // string's u and v are apart, so that stretch would ring at v's own modes and pull the bridge at
-// them; the geometric string's follows u down. The same shift at both levels, v's velocity kept;
-// the energy it takes is counted with the switch's.
+// them; the geometric string's follows u down. Each level's own, so that v lets go of the
+// stretch's motion too; the energy it takes is counted with the switch's.
 void StringVoice::releaseStretch() noexcept {
   const NonlinearString& string = scheme_->system().string();
   const Eigen::Index nu = string.transverseSize(), nv = string.grid().longitudinal - 1;
   if (nv < 1) return;
   levelN_ = scheme_->q();
   levelNext_ = scheme_->qNext();
-  string.quasiStaticStretch(levelN_, levelNext_, stretch_.data());
-  levelN_.segment(nu, nv) -= stretch_;
-  levelNext_.segment(nu, nv) -= stretch_;
+  for (Vector* level : {&levelN_, &levelNext_}) {
+    string.quasiStaticStretch(*level, stretch_.data());
+    level->segment(nu, nv) -= stretch_;
+  }
   scheme_->setLevels(levelN_, levelNext_, 0);
 }
 
