@@ -350,16 +350,14 @@ void NonlinearString::quasiStaticStretch(const Vector& q, double* v) const noexc
   const Eigen::Index m = segments_, mv = grid_.longitudinal;
   if (mv < 2) return;
   const double invH = 1.0 / h_;
-  auto slope = [&](const Vector& x, Eigen::Index l) {  // ζ_l, u_0 = u_M = 0
-    const double left = l == 0 ? 0.0 : x[l - 1], right = l == m - 1 ? 0.0 : x[l];
-    return (right - left) * invH;
-  };
+  double* up = work3_.data();
+  padded(q.data(), m, up);
   double* z = cell1_.data();
   double mean = 0.0;
   for (Eigen::Index j = 0; j < mv; ++j) {
     double sum = 0.0;
     for (Eigen::Index l = j * ratio_; l < (j + 1) * ratio_; ++l) {
-      const double zeta = slope(q, l);
+      const double zeta = (up[l + 1] - up[l]) * invH;
       sum += zeta * zeta;
     }
     z[j] = sum / ratio_;

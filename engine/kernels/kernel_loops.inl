@@ -249,7 +249,10 @@ HAMILTONE_TARGET inline Lanes loadLanes(const double* p) {
 HAMILTONE_TARGET void modalStep(long n, const double* __restrict c1, const double* __restrict c2,
                                 const double* const* w, double f, double* __restrict older,
                                 const double* __restrict newer, double out[4]) {
-  const double* __restrict w0 = w[0], * __restrict w1 = w[1], * __restrict w2 = w[2], * __restrict w3 = w[3];
+  const double* __restrict w0 = w[0];
+  const double* __restrict w1 = w[1];
+  const double* __restrict w2 = w[2];
+  const double* __restrict w3 = w[3];
   const Lanes force = Lanes{} + f;
   Lanes s0 = {}, s1 = {}, s2 = {}, s3 = {};
   long m = 0;
@@ -302,8 +305,8 @@ HAMILTONE_TARGET void sineRows(long i, long n, long terms, const double* in, con
                                const double* twoCos, double scale, double* out) {
   Lanes before[Rows] = {}, now[Rows], twoC[Rows], sum[Rows] = {};
   for (int r = 0; r < Rows; ++r) {
-    __builtin_memcpy(&now[r], sinTheta + i + r * kLanes, sizeof(Lanes));
-    __builtin_memcpy(&twoC[r], twoCos + i + r * kLanes, sizeof(Lanes));
+    now[r] = loadLanes(sinTheta + i + r * kLanes);
+    twoC[r] = loadLanes(twoCos + i + r * kLanes);
   }
   for (long t = 0; t < terms; ++t) {
     for (int r = 0; r < Rows; ++r) {

@@ -627,8 +627,7 @@ constexpr Parameter kTable[] = {
             "longitudinal wave kept at its speed — in its sine modes, the highest dropped as they "
             "fall under −100 dB of its energy (−80 dB under the player's live tail; a felt damper "
             "on it takes it back to its nodes), at 0.09–0.19 of the cost; a strike makes it "
-            "geometric again. The pitch is then off by "
-            "at most 866 × this cents (1e-4: 0.087 "
+            "geometric again. The pitch is then off by at most 866 × this cents (1e-4: 0.087 "
             "cents; measured about half that). 0: never (the research configuration). two-grid "
             "and longitudinal only: on the transverse grid the linear v would not be stable, and "
             "the string stays geometric."},
