@@ -621,14 +621,15 @@ constexpr Parameter kTable[] = {
      .max = 1e-3,
      .defaultText = "1e-4",
      .model = kString,
-     .doc = "The linear tail: once the hammer is back and the tension modulation's bound from "
-            "the string's energy H (ΔT/βT0 <= EA H / (β²T0² L), β the bend's tension scale) is "
-            "under this, the string is stepped linear — V' dropped for its quadratic part, the "
+     .doc = "The linear tail: once the hammer is back and the bound from the string's energy H on "
+            "its tension modulation's mean over a period (<ΔT>/βT0 <= EA H / (2 β²T0² L), half "
+            "of H potential on average, β the bend's tension scale) is under this, the string is "
+            "stepped linear — V' dropped for its quadratic part, the "
             "longitudinal wave kept at its speed — in its sine modes, the highest dropped as they "
             "fall under −100 dB of its energy (−80 dB under the player's live tail; a felt damper "
             "on it takes it back to its nodes), at 0.09–0.19 of the cost; a strike makes it "
             "geometric again. The pitch is then off by at most 866 × this cents (1e-4: 0.087 "
-            "cents; measured about half that). 0: never (the research configuration). two-grid "
+            "cents; measured 0.064). 0: never (the research configuration). two-grid "
             "and longitudinal only: on the transverse grid the linear v would not be stable, and "
             "the string stays geometric."},
     {.name = "scheme.epsilon_J",

@@ -564,13 +564,15 @@ double StringVoice::pickup(const Vector& q, const Vector& qNext, const PickupTap
 }
 
 // The linear tail. The tension modulation, ΔT = (EA/2) Z̄ with Z̄ = (1/L) ∫ u_x² the mean square
-// slope, raises the pitch by ΔT/βT0 of the bent tension, and is bounded at every instant by the
-// energy: H >= ½ βT0 L Z̄ (the rest of H — kinetic, bending, v, the hammer parked at rest — is
-// >= 0), so ΔT/βT0 <= EA H / (β² T0² L). Once the hammer is parked and that bound has fallen under
-// linearBelow (kMaxLinearBelow, if larger, under the live tail), V' is dropped for its quadratic
-// part at rest (NonlinearString::setLinearised), and a step is Störmer–Verlet on the linear string,
-// one pass; over twice the threshold it went linear at (energy the bridge brings from a sibling
-// string, or a bend down) it is geometric again. Each switch
+// slope, raises the pitch by its mean over a period, ⟨ΔT⟩/βT0 of the bent tension. That mean is
+// bounded by the energy: over whole periods a vibrating string holds half of H as potential energy
+// (the virial theorem: ⟨kinetic⟩ = ⟨potential⟩), of which the tension's ½ βT0 L ⟨Z̄⟩ is a part
+// (bending, v and the hammer parked at rest hold the rest, >= 0), so ⟨ΔT⟩/βT0 <=
+// EA H / (2 β² T0² L); at an instant ΔT reaches twice that. Once the hammer is parked and that
+// bound has fallen under linearBelow (kMaxLinearBelow, if larger, under the live tail), V' is
+// dropped for its quadratic part at rest (NonlinearString::setLinearised), and a step is
+// Störmer–Verlet on the linear string, one pass; over twice the threshold it went linear at (energy
+// the bridge brings from a sibling string, or a bend down) it is geometric again. Each switch
 // changes the energy by what ψ held less the quadratic part, counted with what the strikes put
 // in. Checked at fixed step counts, so the output does not depend on the block size. A linear
 // string with no felt damper on it then steps its modes, the highest of them dropped as they fall
@@ -581,7 +583,7 @@ void StringVoice::checkLinear() noexcept {
   const StringPhysics& p = string.physics();
   const double beta = string.tensionScale();
   const double modulation =
-      p.young * p.area * energy() / (beta * beta * p.tension * p.tension * p.length);
+      p.young * p.area * energy() / (2.0 * beta * beta * p.tension * p.tension * p.length);
   const double below =
       liveTail_ ? std::max(patch_.linearBelow, kMaxLinearBelow) : patch_.linearBelow;
   if (!linear_ && parked_ && modulation < below) {
