@@ -103,10 +103,14 @@ void Soundboard::prepare(const SoundboardPhysics& p, double sampleRate,
     c3_[i] = k_ * k_ / (mass_ * damp);
   }
   const int pointCount = static_cast<int>(bridgePoints.size());
-  phi_.resize(pointCount, modeCount);
+  ldModes_ = bodyPadded(modeCount);
+  phi_.assign(pointCount * ldModes_, 0.0f);
+  phiColumns_.resize(modeCount, pointCount);
   for (int k = 0; k < pointCount; ++k)
-    for (int i = 0; i < modeCount; ++i) phi_(k, i) = static_cast<float>(shape(i, bridgePoints[k]));
-  phiColumns_ = phi_.transpose().cast<double>();
+    for (int i = 0; i < modeCount; ++i) {
+      phi_[k * ldModes_ + i] = static_cast<float>(shape(i, bridgePoints[k]));
+      phiColumns_(i, k) = phi_[k * ldModes_ + i];
+    }
   loops_ = &selectedBodyLoops();
   pickupShapes_.resize(2, modeCount);
   for (int j = 0; j < 2; ++j)
@@ -148,8 +152,9 @@ void Soundboard::addForces(std::span<const double> forces) noexcept {
 }
 
 void Soundboard::step() noexcept {
-  const long n = a_.size(), points = phi_.rows();
-  loops_->project(phi_.data(), n, points, n, force_.data(), g_.data());  // g_m = Σ_k φ_m F_k
+  const long n = a_.size(), points = force_.size();
+  loops_->combineRows(phi_.data(), ldModes_, points, force_.data(), 0, n,
+                      g_.data());  // g_m = Σ_k φ_m(x_k) F_k
   const double* c1 = c1_.data();
   const double* c2 = c2_.data();
   const double* c3 = c3_.data();
@@ -171,7 +176,8 @@ void Soundboard::step() noexcept {
   supplied_ += lastWork_;
   a_.swap(aPrev_);
   wPrev_.swap(w_);
-  loops_->gather(phi_.data(), n, active_.data(), activeCount_, n, a_.data(), w_.data());  // w = Φa
+  loops_->dotRows(phi_.data(), ldModes_, active_.data(), activeCount_, n, a_.data(),
+                  w_.data());  // w_k = Σ_m φ_m(x_k) a_m
   force_.setZero();
 }
 
@@ -180,10 +186,11 @@ void Soundboard::setActivePoints(std::span<const int> points) noexcept {
   std::copy_n(points.begin(), activeCount_, active_.begin());
 }
 
+// The same sum, to the bit, as the step's at that point.
 void Soundboard::refreshPoint(int point) noexcept {
   const long n = a_.size();
-  loops_->gather(phi_.data(), n, &point, 1, n, a_.data(), w_.data());
-  loops_->gather(phi_.data(), n, &point, 1, n, aPrev_.data(), wPrev_.data());
+  loops_->dotRows(phi_.data(), ldModes_, &point, 1, n, a_.data(), w_.data());
+  loops_->dotRows(phi_.data(), ldModes_, &point, 1, n, aPrev_.data(), wPrev_.data());
 }
 
 void Soundboard::pickups(double& left, double& right) const noexcept {

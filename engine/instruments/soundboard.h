@@ -42,7 +42,7 @@ class Soundboard {
                std::span<const BoardPoint> bridgePoints, const BoardPoint (&pickups)[2]);
   void reset() noexcept;  // the board at rest, the tallies zero; keeps the modes
 
-  int points() const noexcept { return static_cast<int>(phi_.rows()); }
+  int points() const noexcept { return static_cast<int>(w_.size()); }
   // The points in use (all after prepare): step() computes w at these only, the others keep
   // stale values. Forces may act at any point: they reach the modes whatever this list, and so
   // does their work in supplied(). Copies; no allocation.
@@ -85,9 +85,10 @@ class Soundboard {
   std::vector<std::pair<int, int>> index_;
   Eigen::VectorXd omega_, omegaHat2_, sigma_;
   Eigen::VectorXd c1_, c2_, c3_;  // a^{n+1} = c1 a^n − c2 a^{n−1} + c3 g   (S1 solved)
-  // Φ: points × modes, row-major (each point's modes contiguous), in float (body_loops.h):
-  // w = Φa, g = Φᵀ F. phiColumns_ holds the same values, modes × points, in double.
-  Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> phi_;
+  // Φ: points × modes, each point's modes contiguous (ldModes_ a row, padded with zeros), in float
+  // (body_loops.h): g = Φᵀ F, w = Φa. phiColumns_ holds the same values, modes × points, in double.
+  std::vector<float> phi_;
+  long ldModes_ = 0;
   Eigen::MatrixXd phiColumns_;
   const BodyLoops* loops_ = nullptr;
   Eigen::Matrix<double, 2, Eigen::Dynamic, Eigen::RowMajor> pickupShapes_;

@@ -152,6 +152,27 @@ TEST(Soundboard, SameInputSameBits) {
   EXPECT_EQ(a.energy(), b.energy());
 }
 
+// w = Φa is taken only at the points in use; a point brought back (refreshPoint) reads the same
+// bits as a board that took it at every step, and so does every point in use.
+TEST(Soundboard, ARefreshedPointReadsAsIfItHadBeenInUse) {
+  Soundboard all = preparedBoard(), some = preparedBoard();
+  std::vector<int> third;
+  for (int k = 0; k < 88; k += 3) third.push_back(k);
+  some.setActivePoints(third);
+  for (int n = 0; n < 500; ++n) {
+    for (Soundboard* b : {&all, &some}) b->addForce((7 * n) % 88, std::sin(n * 0.03));
+    all.step();
+    some.step();
+  }
+  for (int k : third) EXPECT_EQ(some.displacement(k), all.displacement(k)) << k;
+  for (int k : {1, 44, 86}) {
+    some.refreshPoint(k);
+    EXPECT_EQ(some.displacement(k), all.displacement(k)) << k;
+    EXPECT_EQ(some.previousDisplacements()[k], all.previousDisplacements()[k]) << k;
+  }
+  EXPECT_NE(all.displacement(44), 0.0);
+}
+
 void expectRefused(const SoundboardPhysics& p, std::vector<BoardPoint> points,
                    std::vector<std::string> words) {
   Soundboard board;
