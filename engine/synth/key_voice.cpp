@@ -121,12 +121,15 @@ double KeyVoice::fundamentalHz() const {
   return plate ? plate->lowestModeHz() : std::get_if<UnisonStrings>(&voice_)->fundamentalHz();
 }
 
-void KeyVoice::process(size_t frames, double gain) noexcept {
-  frames_ = frames;
-  freedAt_ = -1;
-  const std::span<float> left(outLeft_.data(), frames), right(outRight_.data(), frames);
-  size_t done = 0;
-  while (done < frames) {
+void KeyVoice::process(size_t from, size_t frames, double gain) noexcept {
+  if (from == 0) {
+    freedAt_ = -1;
+    fadedOut_ = false;
+  }
+  const size_t end = from + frames;
+  frames_ = end;
+  size_t done = from;
+  while (!fadedOut_ && done < end) {
     if (!fading() && pending()) {  // the fade is over (or its voices fell silent): strike
       strikeNow(pendingVelocity_, pendingUnaCorda_);
       freedAt_ = -1;
@@ -135,20 +138,20 @@ void KeyVoice::process(size_t frames, double gain) noexcept {
       releasePending_ = false;
     }
     const bool wasFading = fading();
-    size_t length = frames - done;
+    size_t length = end - done;
     if (wasFading) length = std::min(length, static_cast<size_t>(fadeLeft_));
     render(done, length, gain);
     done += length;
     if (wasFading && !fading()) {          // free the voices; a pending strike starts next round
       freedAt_ = static_cast<long>(done);  // whether or not its strings fell quiet in the fade
       std::visit([](auto& v) { v.reset(); }, voice_);
-      if (!pending()) break;
+      fadedOut_ = !pending();
     }
   }
   // A key whose fade ended inside the piece is silent for the rest of it.
-  std::fill(left.begin() + done, left.end(), 0.0f);
-  std::fill(right.begin() + done, right.end(), 0.0f);
-  std::fill(boardForce_.begin() + done, boardForce_.begin() + frames, 0.0f);
+  std::fill(outLeft_.begin() + done, outLeft_.begin() + end, 0.0f);
+  std::fill(outRight_.begin() + done, outRight_.begin() + end, 0.0f);
+  std::fill(boardForce_.begin() + done, boardForce_.begin() + end, 0.0f);
 }
 
 void KeyVoice::render(size_t offset, size_t n, double gain) noexcept {

@@ -42,10 +42,13 @@ class KeyVoice {
   bool takesLiveTail() const;
   int stringsInModes() const;  // UnisonStrings'; a plate: 0
 
-  // Writes the key's next `frames` samples (at most maxBlock), times `gain`, into its own output
-  // (left(), right()): the synthesizer sums the keys' outputs in a fixed order, so the mix does not
-  // depend on which thread rendered which key. Touches nothing outside the key. Never allocates.
-  void process(size_t frames, double gain) noexcept;
+  // Writes the key's next `frames` samples, times `gain`, into its own output (left(), right()) at
+  // [from, from + frames) of a piece of at most maxBlock: from = 0 starts a piece, and a piece
+  // written in parts is the same, to the bit, as written at once. The synthesizer sums the keys'
+  // outputs in a fixed order, so the mix does not depend on which thread rendered which key.
+  // Touches nothing outside the key. Never allocates.
+  void process(size_t from, size_t frames, double gain) noexcept;
+  void process(size_t frames, double gain) noexcept { process(0, frames, gain); }
   std::span<const float> left() const { return {outLeft_.data(), frames_}; }  // the last process()
   std::span<const float> right() const { return {outRight_.data(), frames_}; }
   // What the key's bridge passed to the soundboard over the last process(), N per sample (faded
@@ -89,6 +92,8 @@ class KeyVoice {
   std::vector<float> mixLeft_, mixRight_, outLeft_, outRight_, boardForce_;
   size_t frames_ = 0;  // written to the outputs by the last process()
   long freedAt_ = -1;
+  bool fadedOut_ =
+      false;  // its fade ended in this piece with no strike after it: silent to its end
   double panLeft_ = 1.0, panRight_ = 1.0;
   int fadeSamples_ = 1, fadeLeft_ = 0;
   double pendingVelocity_ = -1.0;  // < 0: none

@@ -68,6 +68,7 @@ void Synth::prepare(std::vector<Instrument> instruments, const SynthSetup& setup
     body->driving.assign(count, nullptr);
     body->rejoins.assign(count, {-1, 0});
     body->drivers.assign(count, 0);
+    body->slots.assign(count, 0);
     body->struck.assign(count, 0);
     body->excludedAt.assign(count, kNever);
     body->contact.assign(count, -1.0);
@@ -85,6 +86,10 @@ void Synth::prepare(std::vector<Instrument> instruments, const SynthSetup& setup
   hasVoice_ = std::move(hasVoice);
   gains_ = std::move(gains);
   busy_.assign(keys, {});
+  keyParts_ = std::make_unique<std::atomic<int>[]>(keys);
+  keyFreedAt_ = std::make_unique<std::atomic<long>[]>(keys);
+  partKeys_ = std::make_unique<std::atomic<int>[]>((setup.maxBlock + kPart - 1) / kPart);
+  mixedParts_ = std::make_unique<std::atomic<int>>(0);
   pool_ = std::move(pool);
   bodies_ = std::move(bodies);
   master_ = master;
@@ -353,128 +358,6 @@ void Synth::handle(const MidiMessage& m) noexcept {
     default:
       break;
   }
-}
-
-void Synth::render(std::span<float> left, std::span<float> right) noexcept {
-  int count = 0;
-  for (size_t p = 0; p < voices_.size(); ++p) {
-    Body* body = bodies_[p].get();
-    if (body) body->driverCount = 0;
-    for (size_t key = 0; key < voices_[p].size(); ++key) {
-      KeyVoice& v = voices_[p][key];
-      if (!v.busy()) continue;
-      busy_[count++] = {&v, gains_[p]};
-      // The keys rendered in this piece drive the body over all of it (one may fall silent and
-      // free itself inside it: its force is zero from then on).
-      if (body) body->drivers[body->driverCount++] = static_cast<int>(key);
-    }
-  }
-  auto renderKey = [this, frames = left.size()](int k) noexcept {
-    busy_[k].voice->process(frames, busy_[k].gain);
-  };
-  pool_->run(count, renderKey);
-  // The keys' outputs summed in (instrument, note) order: the same float additions, in the same
-  // order, whichever thread rendered which key.
-  for (int k = 0; k < count; ++k) {
-    const std::span<const float> keyLeft = busy_[k].voice->left(),
-                                 keyRight = busy_[k].voice->right();
-    for (size_t i = 0; i < left.size(); ++i) {
-      left[i] += keyLeft[i];
-      right[i] += keyRight[i];
-    }
-  }
-  for (size_t p = 0; p < bodies_.size(); ++p)
-    if (bodies_[p]) renderBody(p, left, right);
-}
-
-// The body after the keys. What it does never depends on how the audio is cut into pieces: a key
-// leaves the sympathetic coupling when it is struck (an event, at its sample) and comes back at
-// the sample its voice ends (KeyVoice::freedAt), or when the body rests; the dampers move at
-// events; and the body goes to rest — exactly zero, so that
-// stepping it or not is the same — only at multiples of kBodyRestCheck samples, once undriven and
-// under the voices' quiet floor (−100 dBFS at the output) for that long — or at once when the
-// 5 ms fade of a CC120 ends, which is an event's sample plus a fixed count.
-void Synth::renderBody(size_t program, std::span<float> left, std::span<float> right) noexcept {
-  Body& b = *bodies_[program];
-  const int drivers = b.driverCount;
-  b.rejoinCount = 0;
-  for (int d = 0; d < drivers; ++d) {
-    const int key = b.drivers[d];
-    const KeyVoice& v = voices_[program][key];
-    b.driving[d] = v.boardForce().data();
-    if (v.order() != b.struck[key]) {  // struck since: its strings are the voice's now
-      b.struck[key] = v.order();
-      b.excludedAt[key] = b.clock;
-      b.body.setExcluded(key, true);
-    }
-    // Fallen silent in this piece, and not struck again: from that sample its strings are the
-    // body's again, at rest on the board, to ring in sympathy with the keys played after it.
-    if (!v.busy() && v.freedAt() >= 0) b.rejoins[b.rejoinCount++] = {v.freedAt(), key};
-  }
-  auto rejoin = [&](long sample) {
-    for (int r = 0; r < b.rejoinCount; ++r)
-      if (b.rejoins[r].first == sample) b.body.setExcluded(b.rejoins[r].second, false);
-  };
-  for (size_t key = 0; key < b.forces.size(); ++key) {
-    const KeyVoice& v = voices_[program][key];
-    const int k = static_cast<int>(key);
-    const double contact = (v.down || v.caught) ? 0.0 : contact_;  // the pedal lifts every damper
-    if (contact != b.contact[key]) {
-      b.body.setDamper(k, contact);
-      b.contact[key] = contact;
-    }
-  }
-  if (b.resting && drivers == 0) {  // none to rejoin: a driver is a key busy at the start
-    b.clock += static_cast<long>(left.size());
-    b.fadeLeft = static_cast<int>(std::max(0L, b.fadeLeft - static_cast<long>(left.size())));
-    return;
-  }
-  for (size_t i = 0; i < left.size(); ++i) {
-    if (b.rejoinCount > 0) rejoin(static_cast<long>(i));
-    bool pushed = false;
-    for (int d = 0; d < drivers; ++d) {
-      const double f = b.driving[d][i];
-      b.forces[b.drivers[d]] = f;
-      pushed = pushed || f != 0.0;
-    }
-    if (pushed) {
-      b.resting = false;
-      b.lastPush = b.clock;
-    }
-    ++b.clock;
-    // Linear to zero, as a voice fades (KeyVoice::render).
-    double gain = b.gain;
-    bool silenced = false;
-    if (b.fadeLeft > 0) {
-      gain *= static_cast<double>(--b.fadeLeft) / b.fadeSamples;
-      silenced = b.fadeLeft == 0;
-    }
-    if (b.resting) continue;
-    b.body.step(b.forces);
-    double l, r;
-    b.body.output(l, r);
-    left[i] += static_cast<float>(gain * l);
-    right[i] += static_cast<float>(gain * r);
-    if (std::max(std::abs(b.gain * l), std::abs(b.gain * r)) > QuietDetector::kFloor)
-      b.lastLoud = b.clock;
-    if (silenced || (b.clock % kBodyRestCheck == 0 && b.clock - b.lastPush >= kBodyRestCheck &&
-                     b.clock - b.lastLoud >= kBodyRestCheck))
-      rest(b);
-  }
-  if (b.rejoinCount > 0) rejoin(static_cast<long>(left.size()));  // silent from the piece's end
-}
-
-// At rest, exactly; every key's strings back on the board — but those of a key struck in the
-// last kBodyRestCheck samples, whose voice may not have pushed yet (its hammer in flight) or was
-// struck during a CC120's fade: they are the voice's until the next rest.
-void Synth::rest(Body& b) noexcept {
-  b.body.reset();
-  for (size_t key = 0; key < b.forces.size(); ++key) {
-    b.body.setExcluded(static_cast<int>(key), b.clock - b.excludedAt[key] < kBodyRestCheck);
-    b.forces[key] = 0.0;
-  }
-  b.fadeLeft = 0;
-  b.resting = true;
 }
 
 void Synth::process(std::span<float> left, std::span<float> right,

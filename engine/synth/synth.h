@@ -4,6 +4,7 @@
 // the worker threads (SynthSetup::threads) are handed over without a lock (synth/worker_pool.h).
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -142,9 +143,10 @@ class Synth {
 
   struct BusyKey {
     KeyVoice* voice;
-    double gain;  // its instrument's
+    double gain;                // its instrument's
+    const float *left, *right;  // its outputs (read while it renders its next part)
   };
-  // An instrument's body (BodyPatch), stepped after its keys, sample by sample, on this thread:
+  // An instrument's body (BodyPatch), stepped sample by sample after its keys (synth_render.cpp):
   // the keys' bridges drive it, every key not sounding as a voice rings in it in sympathy (its
   // damper lifted while the key is held, caught by the sostenuto or the pedal is down).
   struct Body {
@@ -152,7 +154,9 @@ class Synth {
     std::vector<double> forces;  // per key, this sample, N
     std::vector<int> drivers;    // the keys rendered this piece (driverCount), in order …
     int driverCount = 0;
-    std::vector<const float*> driving;  // … and their board forces
+    std::vector<const float*> driving;  // … and their board forces …
+    std::vector<int> slots;             // … and their places in busy_
+    bool idle = false;                  // resting with no driver: nothing to step this piece
     // The keys whose voices ended in this piece (rejoinCount) and the sample their strings come
     // back to the board.
     std::vector<std::pair<long, int>> rejoins;
@@ -167,7 +171,16 @@ class Synth {
     bool resting = true;
   };
   static constexpr long kBodyRestCheck = 4096;  // samples between the body's rest checks
-  void renderBody(size_t program, std::span<float> left, std::span<float> right) noexcept;
+  // A piece: its keys, then each body over it; on the pool, in parts of kPart samples, a body
+  // stepping one part while the keys render the next (synth_render.cpp).
+  static constexpr size_t kPart = 64;
+  void renderAtOnce(int count, std::span<float> left, std::span<float> right) noexcept;
+  void renderInParts(int count, std::span<float> left, std::span<float> right) noexcept;
+  void mixKeys(int count, size_t from, size_t to, std::span<float> left,
+               std::span<float> right) noexcept;
+  void beginBody(size_t program, size_t frames) noexcept;
+  void stepBody(size_t program, size_t from, size_t to, size_t frames, std::span<float> left,
+                std::span<float> right) noexcept;
   static void rest(Body& b) noexcept;
   static constexpr long kNever = -(1L << 40);  // a clock long before any sample
 
@@ -178,6 +191,13 @@ class Synth {
   // The keys a piece renders, in (instrument, note) order; room for every key.
   std::vector<BusyKey> busy_;
   std::unique_ptr<WorkerPool> pool_;  // renders busy_ (a pointer: the pool's threads stay put)
+  // In parts: per busy key, the parts it has rendered and the sample its voice ended at (−1: not
+  // in this piece); per part, the keys that have rendered it; the parts mixed (keys summed and
+  // bodies stepped). On the heap, so that the synthesizer moves.
+  std::unique_ptr<std::atomic<int>[]> keyParts_;
+  std::unique_ptr<std::atomic<long>[]> keyFreedAt_;
+  std::unique_ptr<std::atomic<int>[]> partKeys_;
+  std::unique_ptr<std::atomic<int>> mixedParts_;
   std::vector<std::unique_ptr<Body>> bodies_;  // per instrument; null without a body
   MasterBus master_;
   int maxBlock_ = 0;

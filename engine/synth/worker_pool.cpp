@@ -10,23 +10,7 @@
 
 #include "synth/denormals.h"
 
-#if defined(__x86_64__) || defined(__i386__)
-#include <immintrin.h>
-#endif
-
 namespace hamiltone {
-namespace {
-
-// Tells the core this thread is spinning: less power, and the other hyperthread runs on.
-inline void pause() noexcept {
-#if defined(__x86_64__) || defined(__i386__)
-  _mm_pause();
-#elif defined(__aarch64__)
-  asm volatile("yield");
-#endif
-}
-
-}  // namespace
 
 WorkerPool::WorkerPool(int threads) {
   if (threads < 1)
@@ -101,7 +85,7 @@ void WorkerPool::run(int count, Call call, void* job) noexcept {
   const int wake = std::min(static_cast<int>(workers_.size()), count - 1);
   for (int w = 0; w < wake; ++w) sem_post(&workers_[w]->wake);
   drain();
-  while (done_.load(std::memory_order_acquire) < count) pause();
+  while (done_.load(std::memory_order_acquire) < count) spinPause();
 }
 
 void WorkerPool::drain() noexcept {

@@ -15,7 +15,20 @@
 
 #include "synth/nonblocking.h"
 
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#endif
+
 namespace hamiltone {
+
+// Tells the core this thread is spinning: less power, and the other hyperthread runs on.
+inline void spinPause() noexcept {
+#if defined(__x86_64__) || defined(__i386__)
+  _mm_pause();
+#elif defined(__aarch64__)
+  asm volatile("yield");
+#endif
+}
 
 class WorkerPool {
  public:
@@ -33,11 +46,13 @@ class WorkerPool {
   // of lower priority holds while other threads run. False when the system refuses (no rights).
   bool schedule(int policy, int priority) noexcept;
 
-  // Calls job(i) once for each i in [0, count), on this thread and the workers, in no set order,
-  // and returns once every call has returned. Jobs run with flush-to-zero on (denormals.h) on
-  // every thread, as the synthesizer runs its voices: a job's result must not depend on the thread
-  // it ran on. Real-time safe on this thread: no allocation, lock or blocking call; only a wake-up
-  // posted to each sleeping worker. One caller at a time.
+  // Calls job(i) once for each i in [0, count), on this thread and the workers, and returns once
+  // every call has returned. The calls start in the order of i (each thread claims the next), so
+  // a job may wait for one before it: that one has started on a thread that does not wait for it.
+  // Jobs run with flush-to-zero on (denormals.h) on every thread, as the synthesizer runs its
+  // voices: a job's result must not depend on the thread it ran on. Real-time safe on this thread:
+  // no allocation, lock or blocking call; only a wake-up posted to each sleeping worker. One caller
+  // at a time.
   template <class Job>
   void run(int count, Job& job) noexcept {
     run(

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <memory>
 #include <numbers>
 #include <optional>
@@ -309,6 +310,34 @@ TEST(SynthBody, AllSoundOffSilencesTheBodyToo) {
               ringing, after);
   EXPECT_LT(after, 1e-3f * chord);
   EXPECT_GT(peak(again, 1.1), 1e-2f);
+}
+
+// On the pool, a piece of 128 samples or more goes in parts of 64, the body stepping one part
+// while the keys render the next (synth_render.cpp); one thread renders it at once. The same bits
+// either way, through everything that changes the body inside a piece: a chord under the pedal, a
+// restrike (its fade, then the strike inside the piece), the pedal lifted, all sound off (every
+// voice ends at the end of its fade, and its strings rejoin the board at that sample) and a strike
+// in the body's fade — in blocks of 256 and of 200 (pieces cut at other samples).
+TEST(SynthBody, InPartsOnThePoolTheBodyGivesTheBitsOfOneThread) {
+  const Instrument grand = loadPreset(HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml");
+  const std::vector<TimedMessage> score = {
+      {0.0, cc(64, 127)},  {0.0, on(48, 90)},   {0.0, on(60, 100)}, {0.0, on(64, 80)},
+      {0.0, on(67, 110)},  {0.05, on(60, 120)}, {0.1, off(64)},     {0.12, cc(64, 0)},
+      {0.15, on(72, 100)}, {0.2, cc(120, 0)},   {0.203, on(55, 90)}};
+  for (int block : {256, 200}) {
+    std::vector<testing::Take> takes;
+    for (int threads : {1, 2, 3}) {
+      Synth synth = testing::prepared({grand}, 256, true, threads);
+      takes.push_back(testing::render(synth, score, 0.3, block));
+    }
+    ASSERT_GT(testing::peak(takes[0]), 1e-3f);
+    for (size_t t = 1; t < takes.size(); ++t) {
+      for (const auto& [a, b] :
+           {std::pair{&takes[t].left, &takes[0].left}, std::pair{&takes[t].right, &takes[0].right}})
+        EXPECT_EQ(std::memcmp(a->data(), b->data(), a->size() * sizeof(float)), 0)
+            << t + 1 << " threads, blocks of " << block;
+    }
+  }
 }
 
 // CC120 with keys struck at its sample and during its fade (a sequencer's stop, a loop point):
