@@ -80,16 +80,23 @@ void Synth::prepare(std::vector<Instrument> instruments, const SynthSetup& setup
   master.prepare(setup.sampleRate);
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   auto pool = std::make_unique<WorkerPool>(setup.threads > 0 ? setup.threads : cores);
+  auto keyParts = std::make_unique<std::atomic<int>[]>(keys);
+  auto keyFreedAt = std::make_unique<std::atomic<long>[]>(keys);
+  auto partKeys = std::make_unique<std::atomic<int>[]>((setup.maxBlock + kPart - 1) / kPart);
+  auto mixedParts = std::make_unique<std::atomic<int>>(0);
 
   instruments_ = std::move(instruments);
   voices_ = std::move(voices);
   hasVoice_ = std::move(hasVoice);
   gains_ = std::move(gains);
   busy_.assign(keys, {});
-  keyParts_ = std::make_unique<std::atomic<int>[]>(keys);
-  keyFreedAt_ = std::make_unique<std::atomic<long>[]>(keys);
-  partKeys_ = std::make_unique<std::atomic<int>[]>((setup.maxBlock + kPart - 1) / kPart);
-  mixedParts_ = std::make_unique<std::atomic<int>>(0);
+  keyParts_ = std::move(keyParts);
+  keyFreedAt_ = std::move(keyFreedAt);
+  partKeys_ = std::move(partKeys);
+  mixedParts_ = std::move(mixedParts);
+  // In parts only where each thread has a core: a job waits by spinning, and a thread spinning
+  // for one that has no core to run on would hold it back.
+  inParts_ = pool->threads() > 1 && pool->threads() <= cores;
   pool_ = std::move(pool);
   bodies_ = std::move(bodies);
   master_ = master;

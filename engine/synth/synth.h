@@ -198,6 +198,7 @@ class Synth {
   std::unique_ptr<std::atomic<long>[]> keyFreedAt_;
   std::unique_ptr<std::atomic<int>[]> partKeys_;
   std::unique_ptr<std::atomic<int>> mixedParts_;
+  bool inParts_ = false;  // the pool has 2 threads or more, and no more than the cores
   std::vector<std::unique_ptr<Body>> bodies_;  // per instrument; null without a body
   MasterBus master_;
   int maxBlock_ = 0;

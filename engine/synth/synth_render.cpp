@@ -1,8 +1,8 @@
 // How the synthesizer renders a piece (the samples between two events): its busy keys on the
 // pool, summed in a fixed order, then each instrument's body over the piece, sample by sample.
-// With a body to step and threads to share, the piece goes in parts of kPart samples, so that a
-// body steps one part while the keys render the next: the same operations on the same values, in
-// the same order for each sample, as at once — the same bits.
+// With a body to step and threads to share (no more than the cores), the piece goes in parts of
+// kPart samples, so that a body steps one part while the keys render the next: the same operations
+// on the same values, in the same order for each sample, as at once — the same bits.
 #include <algorithm>
 #include <cmath>
 
@@ -33,7 +33,7 @@ void Synth::render(std::span<float> left, std::span<float> right) noexcept {
     beginBody(p, left.size());
     stepping = stepping || !bodies_[p]->idle;
   }
-  if (stepping && count > 0 && pool_->threads() > 1 && left.size() >= 2 * kPart)
+  if (stepping && count > 0 && inParts_ && left.size() >= 2 * kPart)
     renderInParts(count, left, right);
   else
     renderAtOnce(count, left, right);

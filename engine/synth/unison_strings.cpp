@@ -39,6 +39,7 @@ void UnisonStrings::reset() noexcept {
   quiet_.reset();
   active_ = false;
   wBefore_ = 0.0;
+  sinceGuard_ = 0;
 }
 
 void UnisonStrings::noteOn(double velocity, bool unaCorda) noexcept {
@@ -135,21 +136,22 @@ void UnisonStrings::process(std::span<float> left, std::span<float> right) noexc
 // Per output sample, R scheme steps; each step: every string takes the bridge's w^n, then the
 // bridge takes their pull at q^n and, through sin α, their tension change there (bridge.h). w and
 // u are positive away from the board (the hammer's way), so a tighter string presses the bridge
-// down: the drive is −ΔT sin α. The guard and the quiet check act on the key.
+// down: the drive is −ΔT sin α. The guard and the quiet check act on the key, at its own samples
+// (not where a call ends), so that they do not depend on how the audio is cut.
 void UnisonStrings::processBridged(std::span<float> left, std::span<float> right) noexcept {
   const size_t n = left.size();
   const bool stereo = channels() == 2;
-  auto silence = [&] {
-    std::fill(left.begin(), left.end(), 0.0f);
-    std::fill(right.begin(), right.end(), 0.0f);
-    std::fill(boardForce_.begin(), boardForce_.begin() + n, 0.0f);
+  auto silenceFrom = [&](size_t from) {
+    std::fill(left.begin() + from, left.end(), 0.0f);
+    std::fill(right.begin() + from, right.end(), 0.0f);
+    std::fill(boardForce_.begin() + from, boardForce_.begin() + n, 0.0f);
   };
   freedAt_ = -1;
   if (!active_) {
-    silence();
+    silenceFrom(0);
     return;
   }
-  bool finite = true;
+  const double multiple = strings_.front().patch().guardEnergyMultiple;
   for (size_t i = 0; i < n; ++i) {
     double sum[2] = {0.0, 0.0}, force = 0.0;  // a mono patch leaves sum[1] at 0
     int steps = 0;
@@ -172,17 +174,21 @@ void UnisonStrings::processBridged(std::span<float> left, std::span<float> right
     left[i] = static_cast<float>(sum[0]);
     right[i] = static_cast<float>(stereo ? sum[1] : sum[0]);
     boardForce_[i] = static_cast<float>(force / steps);
-    finite = finite && std::isfinite(sum[0]) && std::isfinite(sum[1]) && std::isfinite(force);
-  }
-  // The guard: a non-finite sample or runaway energy never leaves the key.
-  const double h = energy();
-  const double multiple = strings_.front().patch().guardEnergyMultiple;
-  if (!finite || !std::isfinite(h) || h > multiple * injectedEnergy()) {
-    silence();
-    ++guardEvents_;
-    freedAt_ = 0;  // silenced from the first sample
-    reset();
-    return;
+    // The guard: a non-finite sample never leaves the key, nor does runaway energy, looked at
+    // every kGuardEvery samples of the key's own.
+    bool runaway = !std::isfinite(sum[0]) || !std::isfinite(sum[1]) || !std::isfinite(force);
+    if (!runaway && ++sinceGuard_ == kGuardEvery) {
+      sinceGuard_ = 0;
+      const double h = energy();
+      runaway = !std::isfinite(h) || h > multiple * injectedEnergy();
+    }
+    if (runaway) {
+      silenceFrom(i);
+      ++guardEvents_;
+      freedAt_ = static_cast<long>(i);  // silenced from this sample
+      reset();
+      return;
+    }
   }
   // The board's force falls silent with the sound, at the same sample whatever the block size.
   if (quiet_.update(left, right, n, std::span(boardForce_).first(n))) {

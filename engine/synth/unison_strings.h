@@ -64,6 +64,8 @@ class UnisonStrings {
   double sinAngle_ = 0.0;  // sin α of the bridge: the share of the tension change that pushes it
   bool bridged_ = false, active_ = false;  // active_: the bridged key's, as one voice
   int guardEvents_ = 0;
+  static constexpr int kGuardEvery = 256;  // samples between the guard's looks at the energy
+  int sinceGuard_ = 0;                     // samples since the last look (or the key's start)
   long freedAt_ = -1;
   QuietDetector quiet_;  // the bridged key's, on its summed output
   std::vector<float> boardForce_, scratchLeft_, scratchRight_;

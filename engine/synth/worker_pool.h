@@ -47,8 +47,10 @@ class WorkerPool {
   bool schedule(int policy, int priority) noexcept;
 
   // Calls job(i) once for each i in [0, count), on this thread and the workers, and returns once
-  // every call has returned. The calls start in the order of i (each thread claims the next), so
-  // a job may wait for one before it: that one has started on a thread that does not wait for it.
+  // every call has returned. The jobs are claimed in the order of i (each thread claims the next
+  // and runs it before it claims another), so a job may wait for one before it: that one is held
+  // by a thread that does not wait for it, and will run (a spinning wait then needs that thread
+  // to have a core: no more threads than cores).
   // Jobs run with flush-to-zero on (denormals.h) on every thread, as the synthesizer runs its
   // voices: a job's result must not depend on the thread it ran on. Real-time safe on this thread:
   // no allocation, lock or blocking call; only a wake-up posted to each sleeping worker. One caller

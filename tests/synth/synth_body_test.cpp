@@ -313,7 +313,8 @@ TEST(SynthBody, AllSoundOffSilencesTheBodyToo) {
 }
 
 // On the pool, a piece of 128 samples or more goes in parts of 64, the body stepping one part
-// while the keys render the next (synth_render.cpp); one thread renders it at once. The same bits
+// while the keys render the next (synth_render.cpp); one thread renders it at once, and so do more
+// threads than the machine has cores (3 on a 2-core machine). The same bits
 // either way, through everything that changes the body inside a piece: a chord under the pedal, a
 // restrike (its fade, then the strike inside the piece), the pedal lifted, all sound off (every
 // voice ends at the end of its fade, and its strings rejoin the board at that sample) and a strike
