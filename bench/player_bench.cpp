@@ -18,7 +18,7 @@
 // key at once every 0.5 s, the worst case. The same 64 keys with the strings' live tail on
 // (sustained_live_tail/…, Synth::setLiveTail), as the player turns it on under load before it
 // drops a key: the decaying strings go linear at a tension modulation of 1e-3, not the preset's
-// 1e-4, and drop their modes under −80 dB, not −100 dB. Their tables give what a strike adds to
+// 5e-5, and drop their modes under −80 dB, not −100 dB. Their tables give what a strike adds to
 // its buffer: the mean of the buffers with one less the others' (counter strike_%).
 //
 // --blocks=N sets the buffers timed per run (default 1000, the fewest a 99.9th percentile needs).

@@ -203,7 +203,7 @@ class HamiltonePlugin : public Plugin {
        "",
        {0.0f, 0.0f, 1.0f},
        "On: decaying strings go linear once their tension modulation is under 1e-3, not the "
-       "preset's 1e-4 (pitch moved by under a cent), for about a quarter less CPU in a dense "
+       "preset's 5e-5 (pitch moved by under a cent), for about a quarter less CPU in a dense "
        "pedalled passage; an export sounds as the playback does."},
   };
 

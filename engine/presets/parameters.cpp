@@ -619,7 +619,7 @@ constexpr Parameter kTable[] = {
     {.name = "scheme.linear_below",
      .min = 0,
      .max = 1e-3,
-     .defaultText = "1e-4",
+     .defaultText = "5e-5",
      .model = kString,
      .doc = "The linear tail: once the hammer is back and the bound from the string's energy H on "
             "its tension modulation's mean over a period (<ΔT>/βT0 <= EA H / (2 β²T0² L), half "
@@ -628,8 +628,8 @@ constexpr Parameter kTable[] = {
             "longitudinal wave kept at its speed — in its sine modes, the highest dropped as they "
             "fall under −100 dB of its energy (−80 dB under the player's live tail; a felt damper "
             "on it takes it back to its nodes), at 0.09–0.19 of the cost; a strike makes it "
-            "geometric again. The pitch is then off by at most 866 × this cents (1e-4: 0.087 "
-            "cents; measured 0.064). 0: never (the research configuration). two-grid "
+            "geometric again. The pitch is then off by at most 866 × this cents (5e-5: 0.043 "
+            "cents; measured 0.032). 0: never (the research configuration). two-grid "
             "and longitudinal only: on the transverse grid the linear v would not be stable, and "
             "the string stays geometric."},
     {.name = "scheme.epsilon_J",

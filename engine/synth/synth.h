@@ -84,7 +84,7 @@ class Synth {
   // in. So 0 and 127 are today's up and down to the bit, and 64 is a half pedal (contact 0.45).
   static double damperContact(int value) noexcept;
   // Every string key's live tail (StringVoice::setLiveTail): on, a decaying string goes linear at
-  // a tension modulation of 1e-3 rather than its preset's (1e-4 on grand-piano), and steps its
+  // a tension modulation of 1e-3 rather than its preset's (5e-5 by default), and steps its
   // modes at a tenth to a fifth of the cost, its pitch off by at most 0.87 cents; the modes under
   // −80 dB of its energy are dropped, not −100 dB (kLiveModalFloor). For a live player
   // under load, before it drops keys (app::Player); renders never take it, so their output stays

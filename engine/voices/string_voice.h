@@ -35,7 +35,7 @@ struct StringPatch {
   // (StringVoice::checkLinear) is under this, the string goes linear (V' dropped, its quadratic
   // part kept); back over twice this, or at a strike, it is geometric again. 0: never. Only where
   // v's grid resolves the longitudinal wave (the linear v must be stable).
-  double linearBelow = 1e-4;
+  double linearBelow = 5e-5;
   // Gauge shift ε, J; none: kEpsilonShare of the hardest strike's energy ½ M_H v_max² where v's
   // grid resolves the longitudinal wave, 0 where it does not (docs/string-grids.md).
   std::optional<double> epsilon;

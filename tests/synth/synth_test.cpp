@@ -32,7 +32,7 @@ using testing::Take;
 constexpr double kRate = testing::kTakeRate;
 
 // The live tail moves something only where strings take the linear tail: the piano keys
-// (linear_below 1e-4 by default), and keys already at its bound of 1e-3, whose modes it drops
+// (linear_below 5e-5 by default), and keys already at its bound of 1e-3, whose modes it drops
 // under −80 dB rather than −100; not a plate, nor keys whose preset says 0 (never linear). It
 // follows the instrument a program change chooses.
 TEST(Synth, TakesTheLiveTailOnlyWhereAStringsTailWouldMove) {

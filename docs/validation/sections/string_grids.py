@@ -335,7 +335,7 @@ def run(ctx):
         "and the median ratios moved by ±0.1 between two runs of this report.\n\n"
         "The two grids are the preset's, linear tail included (`scheme.linear_below`, "
         "docs/string-grids.md): once the mean of a string's tension modulation is bounded "
-        "under 1e-4 it is stepped linear, in its sine modes (\"The modal tail\"), which the transverse grid "
+        "under 5e-5 it is stepped linear, in its sine modes (\"The modal tail\"), which the transverse grid "
         "cannot be and the reference is not. Within "
         "these 0.6 s that happens only on soft and short treble strings — F#6 and C7 at 30 and "
         "50 from the hammer's catch, so their glide reads 0; C7 at 80 to 127 before the late "
