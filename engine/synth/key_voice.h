@@ -92,8 +92,8 @@ class KeyVoice {
   std::vector<float> mixLeft_, mixRight_, outLeft_, outRight_, boardForce_;
   size_t frames_ = 0;  // written to the outputs by the last process()
   long freedAt_ = -1;
-  bool fadedOut_ =
-      false;  // its fade ended in this piece with no strike after it: silent to its end
+  // Its fade ended in this piece with no strike after it: silent to the piece's end.
+  bool fadedOut_ = false;
   double panLeft_ = 1.0, panRight_ = 1.0;
   int fadeSamples_ = 1, fadeLeft_ = 0;
   double pendingVelocity_ = -1.0;  // < 0: none
