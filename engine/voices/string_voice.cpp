@@ -408,7 +408,13 @@ void StringVoice::reset() noexcept {
 
 void StringVoice::setBend(double semitones) noexcept {
   // A NaN passes through std::clamp, so it is caught first.
-  bend_ = std::isnan(semitones) ? 0.0 : std::clamp(semitones, -patch_.bendRange, patch_.bendRange);
+  const double bend =
+      std::isnan(semitones) ? 0.0 : std::clamp(semitones, -patch_.bendRange, patch_.bendRange);
+  // The synth sets the wheel's bend at every strike: unchanged, the tension, the coupling and the
+  // modes' recursions are what applyBend would compute again (a third of a strike's work on a
+  // string in its modes, with a sine per mode).
+  if (bend == bend_) return;
+  bend_ = bend;
   applyBend();
 }
 
