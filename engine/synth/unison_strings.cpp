@@ -175,8 +175,10 @@ void UnisonStrings::processBridged(std::span<float> left, std::span<float> right
     right[i] = static_cast<float>(stereo ? sum[1] : sum[0]);
     boardForce_[i] = static_cast<float>(force / steps);
     // The guard: a non-finite sample never leaves the key, nor does runaway energy, looked at
-    // every kGuardEvery samples of the key's own.
-    bool runaway = !std::isfinite(sum[0]) || !std::isfinite(sum[1]) || !std::isfinite(force);
+    // every kGuardEvery samples of the key's own. The samples as they leave, in float: a finite
+    // sum beyond float's range (a gain too large) would leave as an infinity.
+    bool runaway =
+        !std::isfinite(left[i]) || !std::isfinite(right[i]) || !std::isfinite(boardForce_[i]);
     if (!runaway && ++sinceGuard_ == kGuardEvery) {
       sinceGuard_ = 0;
       const double h = energy();

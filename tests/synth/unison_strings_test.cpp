@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <vector>
 
@@ -215,6 +216,48 @@ TEST(UnisonStrings, ABridgeTooLightIsRefusedNamingItsField) {
   } catch (const PresetError& e) {
     EXPECT_NE(std::string(e.what()).find("bridge.mass_kg"), std::string::npos) << e.what();
   }
+}
+
+// The bridged key's guard looks at its samples as they leave, in float, and silences the key from
+// the first one that is not finite, at the same sample whatever the blocks. A gain (beyond the
+// presets' range, which a StringPatch alone still takes) that puts the strike's loudest samples,
+// finite in double, beyond float's range: before, they left the key as infinities with no guard
+// event.
+TEST(UnisonStrings, TheGuardSilencesASampleBeyondFloatFromThatSampleWhateverTheBlocks) {
+  constexpr double kSeconds = 0.1;
+  Instrument piano = grandPiano();
+  UnisonStrings measured;
+  measured.prepare(piano, 60, kRate, kBlock);
+  measured.noteOn(1.0);
+  float peak = 0.0f;
+  for (float x : play(measured, kSeconds)) peak = std::max(peak, std::abs(x));
+  ASSERT_GT(peak, 0.0f);
+  // Twice float's largest at the peak: the samples above half of it overflow.
+  piano.keys[60 - piano.lowestNote].patch.gain *= 2.0 * std::numeric_limits<float>::max() / peak;
+  std::vector<float> out[2];
+  for (int b = 0; b < 2; ++b) {
+    const size_t block = b == 0 ? kBlock : 100;
+    UnisonStrings key;
+    key.prepare(piano, 60, kRate, kBlock);
+    key.noteOn(1.0);
+    std::vector<float> l(block), r(block);
+    while (out[b].size() < kSeconds * kRate) {
+      key.process(l, r);
+      for (size_t i = 0; i < block; ++i) {
+        ASSERT_TRUE(std::isfinite(l[i]) && std::isfinite(r[i]));
+        out[b].push_back(l[i]);
+      }
+      for (float f : key.boardForce()) ASSERT_TRUE(std::isfinite(f));
+    }
+    EXPECT_EQ(key.guardEvents(), 1);
+    EXPECT_FALSE(key.active());
+  }
+  out[1].resize(out[0].size());
+  EXPECT_EQ(out[0], out[1]);
+  // Sound before the guard's sample, none from it on.
+  const auto last = std::find_if(out[0].rbegin(), out[0].rend(), [](float x) { return x != 0.0f; });
+  ASSERT_NE(last, out[0].rend());
+  EXPECT_LT(out[0].rend() - last, static_cast<long>(kSeconds * kRate / 2));
 }
 
 }  // namespace
