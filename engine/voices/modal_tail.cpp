@@ -6,7 +6,8 @@
 namespace hamiltone {
 
 void ModalTail::Grid::prepare(int segments, double spacing, double rhoA) {
-  modes = kept = segments - 1;
+  modes = segments - 1;
+  keep(modes);
   mass = rhoA * spacing;
   // Past the modes, zeros to a whole register: recursions of 0 on 0 that stay 0.
   for (std::vector<double>* x : {&levels[0], &levels[1], &c1, &c2})
@@ -124,8 +125,8 @@ void ModalTail::enter(const Vector& q, const Vector& qNext) noexcept {
   u_.sineSum(*kernels_, qNext.data(), u_.modes, u_.next());
   v_.sineSum(*kernels_, q.data() + nu, v_.modes, v_.now());
   v_.sineSum(*kernels_, qNext.data() + nu, v_.modes, v_.next());
-  u_.kept = u_.modes;
-  v_.kept = v_.modes;
+  u_.keep(u_.modes);
+  v_.keep(v_.modes);
   probeAll();
   takeResidual();
 }
@@ -158,20 +159,6 @@ void ModalTail::leave(Vector& q, Vector& qNext) const noexcept {
   v_.sineSum(*kernels_, v_.next(), v_.kept, qNext.data() + nu);
 }
 
-// The step writes level n + 2 over level n, which then takes the name of n + 1.
-void ModalTail::step(double w) noexcept {
-  now_ = next_;
-  vLast_ = vLastNext_;
-  const double* weights[kProbes];
-  for (int p = 0; p < kProbes; ++p) weights[p] = weights_[p].data();
-  kernels_->modalStep(registers(u_.kept), u_.c1.data(), u_.c2.data(), weights, -forceScale_ * w,
-                      u_.now(), u_.next(), next_.data());
-  u_.newer = 1 - u_.newer;
-  vLastNext_ = kernels_->freeModalStep(registers(v_.kept), v_.c1.data(), v_.c2.data(), vEnd_.data(),
-                                       v_.now(), v_.next());
-  v_.newer = 1 - v_.newer;
-}
-
 double ModalTail::energy() const noexcept {
   double e = 0.0;
   for (const Grid* g : {&u_, &v_})
@@ -191,7 +178,7 @@ double ModalTail::truncate(double floor) noexcept {
       if (dropped + e >= budget) break;
       dropped += e;
       for (int m = from; m < g->kept; ++m) g->now()[m] = g->next()[m] = 0.0;
-      g->kept = from;
+      g->keep(from);
     }
   }
   probeAll();
@@ -200,8 +187,8 @@ double ModalTail::truncate(double floor) noexcept {
 }
 
 void ModalTail::restore() noexcept {
-  u_.kept = u_.modes;  // the dropped modes were set to rest
-  v_.kept = v_.modes;
+  u_.keep(u_.modes);  // the dropped modes were set to rest
+  v_.keep(v_.modes);
   takeResidual();
 }
 

@@ -49,8 +49,22 @@ class ModalTail {
   // The kept modes back to u and v at levels n and n + 1; the other coordinates are left alone.
   void leave(Vector& q, Vector& qNext) const noexcept;
 
-  // One step with the bridge at w (m): the forces −c1 w and −c2 w on the pull's nodes.
-  void step(double w) noexcept;
+  // One step with the bridge at w (m): the forces −c1 w and −c2 w on the pull's nodes. It writes
+  // level n + 2 over level n, which then takes the name of n + 1. (Inline: every sample of every
+  // string in its tail takes it.)
+  void step(double w) noexcept {
+    now_ = next_;
+    vLast_ = vLastNext_;
+    const double* weights[kProbes];
+    for (int p = 0; p < kProbes; ++p) weights[p] = weights_[p].data();
+    kernels_->modalStep(u_.steps, u_.c1.data(), u_.c2.data(), weights, -forceScale_ * w, u_.now(),
+                        u_.next(), next_.data());
+    u_.newer = 1 - u_.newer;
+    if (v_.steps == 0) return;  // no modes of v kept: vLastNext_ stays 0
+    vLastNext_ = kernels_->freeModalStep(v_.steps, v_.c1.data(), v_.c2.data(), vEnd_.data(),
+                                         v_.now(), v_.next());
+    v_.newer = 1 - v_.newer;
+  }
 
   // A probe at level n and at level n + 1.
   double at(Probe p) const { return now_[p]; }
@@ -81,7 +95,8 @@ class ModalTail {
   // recursion's coefficients a^{n+2} = c1 a^{n+1} − c2 a^n, and M⁻¹K and M⁻¹C of each mode.
   struct Grid {
     int modes = 0;      // M − 1
-    int kept = 0;       // all the modes, or a multiple of kMaxLanes
+    int kept = 0;       // all the modes, or a multiple of kMaxLanes (keep())
+    int steps = 0;      // registers(kept): the modes a step runs, the padding's zeros included
     int newer = 1;      // levels[newer] holds n + 1, the other n
     double mass = 0.0;  // ρA h on this grid: M's diagonal
     std::vector<double> levels[2], c1, c2, kappa, gamma;  // the first three to registers(modes)
@@ -91,6 +106,10 @@ class ModalTail {
     const double* now() const { return levels[1 - newer].data(); }
     const double* next() const { return levels[newer].data(); }
     void prepare(int segments, double spacing, double rhoA);
+    void keep(int n) noexcept {
+      kept = n;
+      steps = registers(n);
+    }
     // DST-I of `terms` values into M − 1 (Kernels::sineSums).
     void sineSum(const Kernels& kernels, const double* in, int terms, double* out) const noexcept;
     double modeEnergy(int m, double k, double sigma1) const noexcept;
