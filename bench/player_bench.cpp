@@ -19,7 +19,9 @@
 // (sustained_live_tail/…, Synth::setLiveTail), as the player turns it on under load before it
 // drops a key: the decaying strings go linear at a tension modulation of 1e-3, not the preset's
 // 5e-5, and drop their modes under −80 dB, not −100 dB. Their tables give what a strike adds to
-// its buffer: the mean of the buffers with one less the others' (counter strike_%).
+// its buffer: the mean of the buffers with one less the others' (counter strike_%), and under each
+// a line counting the slowest 1 % of the buffers by the group of 8 keys struck last before them
+// (counters slowest_after_g<g>): which strikes hold the 99th and 99.9th percentiles.
 //
 // --blocks=N sets the buffers timed per run (default 1000, the fewest a 99.9th percentile needs).
 #include <benchmark/benchmark.h>
@@ -34,6 +36,7 @@
 #include <vector>
 
 #include "player.h"
+#include "presets/parameters.h"
 #include "presets/preset_loader.h"
 #include "recording_reporter.h"
 #include "synth/synth.h"
@@ -154,6 +157,13 @@ class Rig {
 
   int sounding() const { return synth_.activeVoices(); }
   bool struck() const { return struck_; }  // the last buffer had keys struck at its start
+  // Which of the keys' groups (playing.group keys each, in order) was struck last; −1 before any
+  // strike or where every key is struck at once.
+  int lastGroup() const {
+    if (playing_.group <= 0 || strikes_ == 0) return -1;
+    const size_t groups = playing_.keys.size() / static_cast<size_t>(playing_.group);
+    return static_cast<int>((strikes_ - 1) % groups);
+  }
   int inModes() const { return synth_.stringsInModes(); }
   bool allSounding() const {
     return synth_.activeVoices() == static_cast<int>(playing_.keys.size());
@@ -203,11 +213,13 @@ void callback(benchmark::State& state, const Playing& playing, int frames) {
   Rig rig(playing, frames);
   for (long n = 0; n < std::lround(playing.warmupS * kSampleRate / frames); ++n) rig.render();
   std::vector<double> seconds(static_cast<size_t>(blocks));
+  std::vector<int> after(static_cast<size_t>(blocks));  // the group struck last, each buffer
   size_t i = 0;
   double sounding = 0.0, inModes = 0.0;
   double struck[2] = {}, count[2] = {};  // the buffers without a strike, and with
   for (auto _ : state) {
     const double s = rig.render();
+    after[i] = rig.lastGroup();
     seconds[i++] = s;
     sounding += rig.sounding();
     inModes += rig.inModes();
@@ -217,6 +229,20 @@ void callback(benchmark::State& state, const Playing& playing, int frames) {
   // Struck in turn, the top keys (no dampers, T60s of a second or two) may fall silent and free
   // themselves between their strikes, as in playing; the chords must all keep sounding.
   if (playing.group == 0 && !rig.allSounding()) state.SkipWithError("not every key kept sounding");
+  // The slowest 1 % of the buffers (at least 10), counted by the group struck last before each:
+  // which strikes hold the tail (counters slowest_after_g<g>).
+  if (playing.group > 0) {
+    std::vector<size_t> order(seconds.size());
+    for (size_t b = 0; b < order.size(); ++b) order[b] = b;
+    const size_t slowest = std::min(order.size(), std::max<size_t>(10, order.size() / 100));
+    std::partial_sort(order.begin(), order.begin() + slowest, order.end(),
+                      [&](size_t a, size_t b) { return seconds[a] > seconds[b]; });
+    const size_t groups = playing.keys.size() / static_cast<size_t>(playing.group);
+    for (size_t g = 0; g < groups; ++g) state.counters["slowest_after_g" + std::to_string(g)] = 0;
+    for (size_t b = 0; b < slowest; ++b)
+      if (after[order[b]] >= 0)
+        state.counters["slowest_after_g" + std::to_string(after[order[b]])]++;
+  }
   state.counters["sounding"] = sounding / static_cast<double>(blocks);
   state.counters["in_modes"] = inModes / static_cast<double>(blocks);
   const Timing t = summarize(std::move(seconds));
@@ -259,6 +285,20 @@ void printRow(int keys, int frames, const benchmark::UserCounters& c, bool sound
   std::printf("\n");
 }
 
+// The sustained run's slowest buffers by the group of keys struck last before each, as a line
+// under its table: "A0–G1 0, G#1–F#2 6, …".
+void printSlowest(int keys, const benchmark::UserCounters& c) {
+  const Playing p = sustained(keys);
+  std::printf("slowest 1 %% of the %d-key buffers, by the keys struck last before them:", keys);
+  for (size_t g = 0; g * p.group < p.keys.size(); ++g) {
+    const auto count = c.find("slowest_after_g" + std::to_string(g));
+    if (count == c.end()) break;
+    std::printf("%s %s–%s %.0f", g == 0 ? "" : ",", noteName(p.keys[g * p.group]).c_str(),
+                noteName(p.keys[(g + 1) * p.group - 1]).c_str(), count->second.value);
+  }
+  std::printf("\n");
+}
+
 // The pool's runs as Markdown tables, for the README.
 void printPoolTable(const RecordingReporter& reporter) {
   bool header = false;
@@ -293,6 +333,9 @@ void printPoolTable(const RecordingReporter& reporter) {
     }
     printRow(keys, kSustainedFrames, r->counters, true);
   }
+  for (int keys : kSustainedKeys)
+    if (const auto* r = reporter.find(poolName(kSustainedFrames, keys, "sustained")))
+      printSlowest(keys, r->counters);
   if (const auto* r =
           reporter.find(poolName(kSustainedFrames, kLiveTailKeys, "sustained_live_tail"))) {
     std::printf(
@@ -301,6 +344,7 @@ void printPoolTable(const RecordingReporter& reporter) {
         "strike |\n|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
         kLiveTailKeys);
     printRow(kLiveTailKeys, kSustainedFrames, r->counters, true);
+    printSlowest(kLiveTailKeys, r->counters);
   }
 }
 
