@@ -180,23 +180,11 @@ void KeyVoice::render(size_t offset, size_t n, double gain) noexcept {
     envelope_ = std::max({static_cast<double>(std::abs(mixL[i])),
                           static_cast<double>(std::abs(mixR[i])), envelope_ * envelopeDecay_});
     loudest_ = std::max(loudest_, envelope_);
-  }
-  if (inFade) {
-    for (size_t i = 0; i < n; ++i) {
-      // Linear to zero: the last faded sample is 0, each step at most peak / 240 at 48 kHz
-      // (process() ends the piece where the fade ends: n <= fadeLeft_).
-      const double fade = static_cast<double>(--fadeLeft_) / fadeSamples_;
-      left[i] = static_cast<float>(gl * fade * mixL[i]);
-      right[i] = static_cast<float>(gr * fade * mixR[i]);
-      force[i] = bridge ? static_cast<float>(fade * bridge[i]) : 0.0f;
-    }
-    return;
-  }
-  // Out of a fade (fade 1, which changes no bit): the envelope's chain above, the gains apart.
-  for (size_t i = 0; i < n; ++i) {
-    left[i] = static_cast<float>(gl * mixL[i]);
-    right[i] = static_cast<float>(gr * mixR[i]);
-    force[i] = bridge ? bridge[i] : 0.0f;
+    // Linear to zero: the last faded sample is 0, and each step is at most peak / 240 at 48 kHz.
+    const double fade = fadeLeft_ > 0 ? static_cast<double>(--fadeLeft_) / fadeSamples_ : 1.0;
+    left[i] = static_cast<float>(gl * fade * mixL[i]);
+    right[i] = static_cast<float>(gr * fade * mixR[i]);
+    force[i] = bridge ? static_cast<float>(fade * bridge[i]) : 0.0f;
   }
 }
 
