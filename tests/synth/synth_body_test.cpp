@@ -341,10 +341,6 @@ TEST(SynthBody, InPartsOnThePoolTheBodyGivesTheBitsOfOneThread) {
   }
 }
 
-// CC120 with keys struck at its sample and during its fade (a sequencer's stop, a loop point):
-// the body fades and rests at a sample fixed by the events, and the keys struck meanwhile stay
-// out of the coupling (their strings are their voices'), so the output is the same, bit for bit,
-// however the audio is cut into blocks.
 // The wheel sent again where it is (a controller's repeats, its centre sent at rest) changes no
 // sample: the strings already hold that bend, their modes' recursions and their probes included.
 // Re-applying it once recomputed the probes of the strings in their modes in another summation
@@ -370,6 +366,10 @@ TEST(SynthBody, AWheelMessageThatChangesNothingChangesNoSample) {
   EXPECT_EQ(takes[0].right, takes[1].right);
 }
 
+// CC120 with keys struck at its sample and during its fade (a sequencer's stop, a loop point):
+// the body fades and rests at a sample fixed by the events, and the keys struck meanwhile stay
+// out of the coupling (their strings are their voices'), so the output is the same, bit for bit,
+// however the audio is cut into blocks.
 TEST(SynthBody, AllSoundOffIsTheSameWhateverTheBlockSize) {
   std::vector<bool> notes(128, false);
   for (int n : {48, 55, 60, 64, 67}) notes[n] = true;
