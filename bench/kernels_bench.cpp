@@ -45,14 +45,11 @@ std::vector<double> paddedU(long m) {
 
 void twoGrids(benchmark::State& state, Isa isa) {
   const Kernels& k = kernelsFor(isa);
-  const std::vector<double> up = paddedU(kFine), eta = wiggle(kCells, 1e-4, 1.3);
-  std::vector<double> scratch(kFine + kMaxLanes), zeta(kFine + kMaxLanes), strain(kCells),
-      inverseStretch(kCells), gu(kFine);
+  const std::vector<double> u = wiggle(kFine - 1, 1e-5, 0.7), v = wiggle(kCells - 1, 1e-6, 1.3);
+  std::vector<double> work(twoGridWork(kFine, kCells)), gu(kFine - 1), gv(kCells - 1);
   for (auto _ : state) {
-    k.cellStretches(up.data(), eta.data(), kCells, kRatio, 100.0, zeta.data(), strain.data(),
-                    inverseStretch.data());
-    k.fineForces(kCells, kRatio, 7.0, 100.0, strain.data(), scratch.data(), zeta.data(), gu.data());
-    benchmark::DoNotOptimize(gu.data());
+    benchmark::DoNotOptimize(k.twoGridForces(u.data(), v.data(), kCells, kRatio, 100.0, 10.0, 7.0,
+                                             600.0, work.data(), gu.data(), gv.data()));
     benchmark::ClobberMemory();
   }
   state.counters["t/segment"] = perSegment(kFine);

@@ -57,6 +57,8 @@ NonlinearString::NonlinearString(const StringPhysics& p, StringGrid grid)
   work3_.setZero(grid.transverse + kMaxLanes);
   for (Vector* w : {&cell1_, &cell2_, &cell3_}) w->setZero(grid.longitudinal);
   scratch_.setZero(grid.transverse + kMaxLanes);
+  if (ratio_ > 1 && grid.longitudinal > 1)
+    forcesWork_.setZero(twoGridWork(grid.transverse, grid.longitudinal));
   d2_.setZero(nu);
   d2Prev_.setZero(nu);
 }
@@ -202,8 +204,46 @@ void NonlinearString::applyStiffnessAndLoss(const Vector& q, const Vector& qPrev
                              physics_.young * physics_.inertia * h_,
                              -rhoA * lossWeights_.transverse * h_);
   d2_.swap(d2Prev_);
+  if (ratio_ > 1 && grid_.longitudinal <= kMaxLanes)
+    return coarseStiffnessAndLoss(q, qPrev, kq, cq);
   longitudinalStiffness(q, kq);
   longitudinalLoss(q, qPrev, cq);
+}
+
+// longitudinalStiffness and longitudinalLoss in one sweep over the few coarse nodes of the two
+// grids' shorter strings (Mv − 1 < kMaxLanes: F3 and up), where two kernel calls and a vector
+// expression cost more than the sweep (C5: 3.5 % of a key; on A0's 42 nodes the kernels are 2–4 %
+// faster); the same operations, v = 0 beyond both ends.
+void NonlinearString::coarseStiffnessAndLoss(const Vector& q, const Vector& qPrev, Vector& kq,
+                                             Vector& cq) const {
+  const Eigen::Index nu = segments_ - 1, nv = grid_.longitudinal - 1;
+  if (nv == 0) return;
+  const double* v = q.data() + nu;
+  const double* w = qPrev.data() + nu;
+  double* kv = kq.data() + nu;
+  double* cv = cq.data() + nu;
+  const double rhoA = physics_.linearDensity();
+  const double stiffness = -(linearised_ ? physics_.young * physics_.area : physics_.tension) / hv_;
+  const double loss = -rhoA * lossWeights_.longitudinal / hv_;
+  // −T0 h_v D2 v and ρA w_v1 h_v (−D2)(v − w) at node j from its neighbours' values.
+  auto node = [&](Eigen::Index j, double left, double right, double dLeft, double dRight) {
+    kv[j] = stiffness * (left - 2.0 * v[j] + right);
+    cv[j] = loss * (dLeft - 2.0 * (v[j] - w[j]) + dRight);
+  };
+  if (nv == 1) {
+    node(0, 0.0, 0.0, 0.0, 0.0);
+  } else {
+    node(0, 0.0, v[1], 0.0, v[1] - w[1]);
+#pragma omp simd
+    for (Eigen::Index j = 1; j < nv - 1; ++j)
+      node(j, v[j - 1], v[j + 1], v[j - 1] - w[j - 1], v[j + 1] - w[j + 1]);
+    node(nv - 1, v[nv - 2], 0.0, v[nv - 2] - w[nv - 2], 0.0);
+  }
+  if (lossWeights_.longitudinalConstant > 0.0) {
+    const double constant = rhoA * hv_ * lossWeights_.longitudinalConstant;
+#pragma omp simd
+    for (Eigen::Index j = 0; j < nv; ++j) cv[j] += constant * (v[j] - w[j]);  // ρA h_v w_v0 (v − w)
+  }
 }
 
 // K q on v: −T0 h_v D2 v; the linear string's −EA h_v D2 v (none where Mv = 1).
@@ -291,14 +331,13 @@ double NonlinearString::singleGridGradient(const Vector& q, Vector& grad) const 
   return 0.5 * c * sum;
 }
 
-// ε_J = S_J − 1 into strain_J and 1/S_J into inverseStretch_J, S_J = sqrt((1 + η_J)² + Z_J), with
-// ζ_l into zeta (docs/string-grids.md, "The strain of a cell").
-void NonlinearString::cellStrains(const Vector& q, double* strain, double* inverseStretch,
-                                  double* zeta) const {
+// ε_J = S_J − 1 into strain_J and 1/S_J into inverseStretch_J, S_J = sqrt((1 + η_J)² + Z_J)
+// (docs/string-grids.md, "The strain of a cell").
+void NonlinearString::cellStrains(const Vector& q, double* strain, double* inverseStretch) const {
   const Eigen::Index m = segments_, mv = grid_.longitudinal;
   padded(q.data(), m, work3_.data());
   longitudinalStrains(q.data() + (m - 1), mv, 1.0 / hv_, cell1_.data());
-  kernels_->cellStretches(work3_.data(), cell1_.data(), mv, ratio_, 1.0 / h_, zeta, strain,
+  kernels_->cellStretches(work3_.data(), cell1_.data(), mv, ratio_, 1.0 / h_, strain,
                           inverseStretch);
 }
 
@@ -384,7 +423,7 @@ double NonlinearString::twoGridPotential(const Vector& q) const {
     return cellsPotential(strain * strain);
   }
   double* strain = cell2_.data();
-  cellStrains(q, strain, cell3_.data(), work1_.data());
+  cellStrains(q, strain, cell3_.data());
   double sum = 0.0;
   for (Eigen::Index j = 0; j < grid_.longitudinal; ++j) sum += strain[j] * strain[j];
   return cellsPotential(sum);
@@ -392,30 +431,17 @@ double NonlinearString::twoGridPotential(const Vector& q) const {
 
 // With c = (EA − T0) h_u, ∂ε_J/∂ζ_l = ζ_l/(r S_J) and ∂ε_J/∂η_J = (1 + η_J)/S_J:
 //   ∂V'/∂ζ_l = c (ε_J/S_J) ζ_l,  ∂V'/∂η_J = c r ε_J (1 + η_J)/S_J,
-// then ∇_u V' = D₋ᵀ(∂V'/∂ζ) on the fine grid and ∇_v V' = D₋ᵀ(∂V'/∂η) on the coarse one.
+// then ∇_u V' = D₋ᵀ(∂V'/∂ζ) on the fine grid and ∇_v V' = D₋ᵀ(∂V'/∂η) on the coarse one, all in
+// one kernel call.
 double NonlinearString::twoGridGradient(const Vector& q, Vector& grad) const {
   const Eigen::Index m = segments_, mv = grid_.longitudinal;
   if (mv == 1) return oneCellGradient(q, grad);
   const double c = (physics_.young * physics_.area - physics_.tension) * h_;
-  double* zeta = work1_.data();
-  double* we = cell2_.data();      // ε_J, then ∂V'/∂η_J
-  double* weight = cell3_.data();  // 1/S_J, then ε_J/S_J
-  cellStrains(q, we, weight, zeta);
-  const double* eta = cell1_.data();
-  const double cr = c * ratio_;
-  double sum = 0.0;
-  for (Eigen::Index j = 0; j < mv; ++j) {
-    const double strain = we[j];
-    sum += strain * strain;
-    weight[j] *= strain;
-    we[j] = cr * weight[j] * (1.0 + eta[j]);
-  }
-  kernels_->fineForces(mv, ratio_, c, 1.0 / h_, weight, scratch_.data(), zeta, grad.data());
-  double* gv = grad.data() + (m - 1);
-  const double invHv = 1.0 / hv_;
-  for (Eigen::Index j = 0; j < mv - 1; ++j) gv[j] = (we[j] - we[j + 1]) * invHv;
-  endTension_ = physics_.tension * eta[mv - 1] + we[mv - 1] * invHv;
-  return cellsPotential(sum);
+  const TwoGridSums sums = kernels_->twoGridForces(
+      q.data(), q.data() + (m - 1), mv, ratio_, 1.0 / h_, 1.0 / hv_, c, physics_.tension,
+      forcesWork_.data(), grad.data(), grad.data() + (m - 1));
+  endTension_ = sums.endTension;
+  return cellsPotential(sums.squaredStrains);
 }
 
 double minimalSpacing(const StringPhysics& p, GridRule rule, double k, double sigma1) {

@@ -151,9 +151,10 @@ class NonlinearString {
   };
   OneCell oneCell(const Vector& q) const;
   double oneCellGradient(const Vector& q, Vector& grad) const;
-  void cellStrains(const Vector& q, double* strain, double* inverseStretch, double* zeta) const;
+  void cellStrains(const Vector& q, double* strain, double* inverseStretch) const;
   void longitudinalStiffness(const Vector& q, Vector& out) const;              // K q on v
   void longitudinalLoss(const Vector& a, const Vector& b, Vector& out) const;  // C(a − b) on v
+  void coarseStiffnessAndLoss(const Vector& q, const Vector& qPrev, Vector& kq, Vector& cq) const;
 
   StringPhysics physics_;
   StringGrid grid_;
@@ -164,11 +165,12 @@ class NonlinearString {
   bool linearised_ = false;
   LossWeights lossWeights_;
   mutable double endTension_ = 0.0;
-  // Work of the stencils and the gradient: per fine segment (size Mu; work3_ holds u padded with
-  // its fixed ends, Mu + 1, then zeros; work1_ and scratch_ the two-grid kernels', Mu + kMaxLanes
-  // each, scratch_ also the single grid's padded v) and per coarse cell (Mv).
+  // Work of the stencils and the potentials, per fine segment (size Mu): work1_ the stiffness
+  // stencil's D2 u and, with work2_, the single grid's ∂V'/∂ζ and ∂V'/∂η; work3_ u padded with its
+  // fixed ends (Mu + 1, then zeros); scratch_ the single grid's padded v. Per coarse cell (Mv):
+  // cell1_ … cell3_. forcesWork_: the two grids' gradient's (Kernels::twoGridForces).
   mutable Vector work1_, work2_, work3_, cell1_, cell2_, cell3_;
-  mutable Vector scratch_;
+  mutable Vector scratch_, forcesWork_;
   mutable Vector d2_, d2Prev_;  // D2 u/h² of applyStiffnessAndLoss's q and of the one before
   const Kernels* kernels_ = &selectedKernels();
 };

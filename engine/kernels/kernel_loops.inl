@@ -12,20 +12,19 @@ constexpr int kLanes = HAMILTONE_KERNEL_LANES;
 static_assert(kLanes <= kMaxLanes);
 
 // Cell by cell, in chunks of four segments on every path (one vector iteration on AVX2 and
-// AVX-512, two on SSE2): a cell's last chunk runs past its r segments into the following cell's
-// (or the padding's), whose ζ it writes again. The loop of one chunk has a fixed trip count, so it
-// vectorises; a loop of r = 8…17 would not. A cell's Σ ζ_l² is four partial sums, one per position
-// in the chunk (its last chunk adds 0 for the segments past the cell), then added as (p0 + p1) +
-// (p2 + p3): every path adds the same values in the same order, so every path gives the same bits.
-// The square roots and divisions, one and two per cell, then run over the cells.
+// AVX-512, two on SSE2): a cell's last chunk reads past its r segments into the following cell's
+// (or the padding's). The loop of one chunk has a fixed trip count, so it vectorises; a loop of r =
+// 8…17 would not. A cell's Σ ζ_l² is four partial sums, one per position in the chunk (its last
+// chunk adds 0 for the segments past the cell), then added as (p0 + p1) + (p2 + p3): every path
+// adds the same values in the same order, so every path gives the same bits. The square roots and
+// divisions, one and two per cell, then run over the cells.
 constexpr int kChunk = 4;
 
 // Four doubles: one vector register on AVX2 and AVX-512, two on SSE2.
 typedef double Chunk __attribute__((vector_size(kChunk * sizeof(double))));
 
 HAMILTONE_TARGET void cellStretches(const double* up, const double* eta, long mv, int r,
-                                    double invH, double* zeta, double* strain,
-                                    double* inverseStretch) {
+                                    double invH, double* strain, double* inverseStretch) {
   const Chunk position = {0.0, 1.0, 2.0, 3.0}, zero = {};
   const double invR = 1.0 / r;
   double* meanSquare = strain;  // Z_J, until the last loop
@@ -37,7 +36,6 @@ HAMILTONE_TARGET void cellStretches(const double* up, const double* eta, long mv
       __builtin_memcpy(&left, up + t, sizeof left);
       __builtin_memcpy(&right, up + t + 1, sizeof right);
       const Chunk z = (right - left) * invH;
-      __builtin_memcpy(zeta + t, &z, sizeof z);
       sum += position < static_cast<double>(end - t) ? z * z : zero;
     }
     meanSquare[j] = ((sum[0] + sum[1]) + (sum[2] + sum[3])) * invR;
@@ -51,19 +49,58 @@ HAMILTONE_TARGET void cellStretches(const double* up, const double* eta, long mv
   }
 }
 
-HAMILTONE_TARGET void fineForces(long mv, int r, double c, double invH, const double* weight,
-                                 double* scratch, const double* zeta, double* gu) {
+// Inside cell J, (D₋ᵀ w)_l = w_J (ζ_l − ζ_{l+1}) / h = −w_J (up[l] − 2 up[l+1] + up[l+2]) / h²
+// with w_J = c ε_J/S_J: a second difference under one weight, in chunks of four (the last may run
+// two nodes into the next cell, which its own loop then writes again, but not past u's last node),
+// then node by node. At the cell's last segment l, where the weight changes, (w_J ζ_l −
+// w_{J+1} ζ_{l+1}) / h.
+HAMILTONE_TARGET TwoGridSums twoGridForces(const double* u, const double* v, long mv, int r,
+                                           double invH, double invHv, double c, double tension,
+                                           double* work, double* gu, double* gv) {
   const long m = mv * r;
-  double* w = scratch;  // ∂V'/∂ζ_l = c weight_J ζ_l, in the chunks of cellStretches
+  double* up = work;                   // u with its fixed ends, then zeros
+  double* eta = up + (m + kMaxLanes);  // η_J
+  double* strain = eta + mv;           // ε_J, then ∂V'/∂η_J
+  double* weight = strain + mv;        // 1/S_J, then c ε_J/S_J
+  up[0] = 0.0;
+  long t = 0;
+  for (; t + kChunk <= m - 1; t += kChunk) __builtin_memcpy(up + 1 + t, u + t, sizeof(Chunk));
+  for (; t < m - 1; ++t) up[1 + t] = u[t];
+  for (long l = m; l < m + kMaxLanes; ++l) up[l] = 0.0;
+  eta[0] = mv == 1 ? 0.0 : v[0] * invHv;  // v = 0 beyond both ends
+  for (long j = 1; j < mv - 1; ++j) eta[j] = (v[j] - v[j - 1]) * invHv;
+  if (mv > 1) eta[mv - 1] = -v[mv - 2] * invHv;
+  cellStretches(up, eta, mv, r, invH, strain, weight);
+  const double cr = c * r;
+  double sum = 0.0;
   for (long j = 0; j < mv; ++j) {
-    const double wj = c * weight[j];
-    for (long t = j * r; t < (j + 1) * r; t += kChunk) {
-#pragma omp simd
-      for (int i = 0; i < kChunk; ++i) w[t + i] = zeta[t + i] * wj;
+    sum += strain[j] * strain[j];
+    const double w = weight[j] * strain[j];
+    weight[j] = c * w;
+    strain[j] = cr * w * (1.0 + eta[j]);  // ∂V'/∂η_J
+  }
+  const double invH2 = invH * invH;
+  for (long j = 0; j < mv; ++j) {
+    const double scale = -weight[j] * invH2;
+    const long last = (j + 1) * r - 1;             // the cell's last segment
+    const long limit = std::min(last + 2, m - 2);  // u's last node
+    long l = j * r;
+    for (; l < last && l + (kChunk - 1) <= limit; l += kChunk) {
+      Chunk a, b, d;
+      __builtin_memcpy(&a, up + l, sizeof a);
+      __builtin_memcpy(&b, up + l + 1, sizeof b);
+      __builtin_memcpy(&d, up + l + 2, sizeof d);
+      const Chunk g = ((a - 2.0 * b) + d) * scale;
+      __builtin_memcpy(gu + l, &g, sizeof g);
+    }
+    for (; l < last; ++l) gu[l] = ((up[l] - 2.0 * up[l + 1]) + up[l + 2]) * scale;
+    if (j + 1 < mv) {
+      const double zl = (up[last + 1] - up[last]) * invH, zr = (up[last + 2] - up[last + 1]) * invH;
+      gu[last] = (zl * weight[j] - zr * weight[j + 1]) * invH;
     }
   }
-#pragma omp simd
-  for (long l = 0; l < m - 1; ++l) gu[l] = (w[l] - w[l + 1]) * invH;
+  for (long j = 0; j < mv - 1; ++j) gv[j] = (strain[j] - strain[j + 1]) * invHv;
+  return {sum, tension * eta[mv - 1] + strain[mv - 1] * invHv};
 }
 
 HAMILTONE_TARGET double singleGridForces(const double* up, const double* vp, long m, double invH,
@@ -399,7 +436,7 @@ HAMILTONE_TARGET void gridBracket(const double* f, const double* g, const double
 extern const Kernels kernels{.isa = HAMILTONE_KERNEL_ISA,
                              .name = HAMILTONE_KERNEL_NAME,
                              .cellStretches = cellStretches,
-                             .fineForces = fineForces,
+                             .twoGridForces = twoGridForces,
                              .singleGridForces = singleGridForces,
                              .secondDifference = secondDifference,
                              .stiffStencil = stiffStencil,

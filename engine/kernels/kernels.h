@@ -13,23 +13,37 @@ namespace hamiltone {
 enum class Isa { portable, avx2, avx512 };
 constexpr int kMaxLanes = 8;  // doubles in the widest vector register (AVX-512)
 
+struct TwoGridSums {
+  double squaredStrains;  // Σ_J ε_J²
+  double endTension;      // N, at the string's last segment
+};
+// The doubles of twoGridForces' work on m fine segments and mv coarse cells.
+constexpr long twoGridWork(long m, long mv) { return m + kMaxLanes + 3 * mv; }
+
 struct Kernels {
   Isa isa;
   const char* name;
   // The two grids' strains (docs/string-grids.md): with up the padded u (u_0 = u_m = 0, m = mv r)
-  // and η_J the coarse strains, each fine segment's slope ζ_l = (up[l+1] − up[l]) invH into zeta,
-  // each cell's mean square slope Z_J = (1/r) Σ_{l∈J} ζ_l² (four partial sums over l ≡ 0, 1, 2, 3
+  // and η_J the coarse strains, each fine segment's slope ζ_l = (up[l+1] − up[l]) invH, each
+  // cell's mean square slope Z_J = (1/r) Σ_{l∈J} ζ_l² (four partial sums over l ≡ 0, 1, 2, 3
   // (mod 4) from the cell's first segment, added as (p0 + p1) + (p2 + p3) on every path), its
   // stretch S_J = sqrt((1 + η_J)² + Z_J), strain_J = S_J − 1 (as (2η + η² + Z)/(S + 1): no
   // cancellation at small strain) and inverseStretch_J = 1/S_J. The loops run in whole chunks of
-  // four segments past the last one: up holds m + kMaxLanes values (finite: zeros past u_m), zeta
-  // m + kMaxLanes.
+  // four segments past the last one: up holds m + kMaxLanes values (finite: zeros past u_m).
   void (*cellStretches)(const double* up, const double* eta, long mv, int r, double invH,
-                        double* zeta, double* strain, double* inverseStretch);
-  // ∇_u V' = D₋ᵀ(c weight_J ζ_l): gu_l = (w_l − w_{l+1}) invH, l < m − 1, zeta as cellStretches
-  // left it. scratch: m + kMaxLanes doubles.
-  void (*fineForces)(long mv, int r, double c, double invH, const double* weight, double* scratch,
-                     const double* zeta, double* gu);
+                        double* strain, double* inverseStretch);
+  // The two grids' gradient in one call (NonlinearString::twoGridGradient): from u (m − 1 values,
+  // m = mv r, u_0 = u_m = 0) and v (mv − 1), η_J = (D₋v)_J, cellStretches' strains, the weights
+  // w_J = c ε_J/S_J of ∂V'/∂ζ_l = w_J ζ_l and ∂V'/∂η_J = c r (ε_J/S_J)(1 + η_J), then
+  // gu = D₋ᵀ(∂V'/∂ζ) (m − 1 values: −w_J (u_{l−1} − 2u_l + u_{l+1}) invH² inside a cell, and
+  // (w_J ζ_l − w_{J+1} ζ_{l+1}) invH at its last node) and gv = D₋ᵀ(∂V'/∂η) invHv (mv − 1).
+  // work: twoGridWork(m, mv) doubles (u is copied there with its ends); nothing past u's m − 1
+  // values is read. Returns Σ_J ε_J² and the
+  // end's tension T η_{mv−1} + (∂V'/∂η)_{mv−1} invHv. The same bits on every path, as
+  // cellStretches'.
+  TwoGridSums (*twoGridForces)(const double* u, const double* v, long mv, int r, double invH,
+                               double invHv, double c, double tension, double* work, double* gu,
+                               double* gv);
   // One grid (BDZ (65)): with up, vp the padded u and v (m + 1 values), ζ_l, η_l their strains
   // and φ_l = (s_l − 1)/s_l, ∂V'/∂ζ_l = c φ_l ζ_l into wz and ∂V'/∂η_l = c φ_l (1 + η_l) into we
   // (m each), gu = D₋ᵀwz and gv = D₋ᵀwe (m − 1 each); returns Σ (s_l − 1)².

@@ -92,46 +92,68 @@ TEST(Kernels, StencilsAndForcesAreBitIdenticalOnEveryPath) {
 
 // The two grids' strains and forces, r fine segments a cell (chunks ending inside a cell, on its
 // edge, several cells to a chunk at r = 1), strains η ~ 1e-4, every buffer exactly the size
-// kernels.h asks (u padded with zeros): each path, the portable one too, gives the bits of the
-// formulas written out here, so the same bits on every path.
+// kernels.h asks: each path, the portable one too, gives the bits of the formulas written out
+// here, so the same bits on every path. twoGridForces' u sits between NaNs, which a read past
+// either of its ends would carry into the results.
 TEST(Kernels, TwoGridStrainsAndForcesAreTheFormulasOnEveryPath) {
   std::vector<const Kernels*> paths = otherPaths();
   paths.push_back(&kernelsFor(Isa::portable));
+  const double invH = 100.0, invHv = 10.0, c = 7.0, tension = 600.0;
   for (long mv : {1L, 2L, 7L, 64L, 343L}) {
     for (int r : {1, 3, 8, 11}) {
       const long m = r * mv;
-      std::vector<double> up = randomArray(m + kMaxLanes, 1e-3, 9);
-      up.front() = 0.0;
-      std::fill(up.begin() + m, up.end(), 0.0);
-      const std::vector<double> eta = randomArray(mv, 1e-4, 10);
-      std::vector<double> zeta(m), strain(mv), inverse(mv), grad(m - 1);
+      const std::vector<double> u = randomArray(m - 1, 1e-3, 9), v = randomArray(mv - 1, 1e-5, 10);
+      std::vector<double> up(m + kMaxLanes, 0.0), eta(mv);
+      std::copy(u.begin(), u.end(), up.begin() + 1);
+      for (long j = 0; j < mv; ++j)
+        eta[j] = ((j < mv - 1 ? v[j] : 0.0) - (j > 0 ? v[j - 1] : 0.0)) * invHv;
+      std::vector<double> zeta(m), strain(mv), inverse(mv), gu(m - 1), gv(mv - 1), w(mv), we(mv);
+      double sum = 0.0;
       for (long j = 0; j < mv; ++j) {
         double z2[4] = {};  // by position l − J r (mod 4)
         for (long l = j * r; l < (j + 1) * r; ++l) {
-          zeta[l] = (up[l + 1] - up[l]) * 100.0;
+          zeta[l] = (up[l + 1] - up[l]) * invH;
           z2[(l - j * r) % 4] += zeta[l] * zeta[l];
         }
         const double mean = ((z2[0] + z2[1]) + (z2[2] + z2[3])) * (1.0 / r);
         const double s = std::sqrt((1.0 + eta[j]) * (1.0 + eta[j]) + mean);
         strain[j] = (2.0 * eta[j] + eta[j] * eta[j] + mean) / (s + 1.0);
         inverse[j] = 1.0 / s;
+        sum += strain[j] * strain[j];
+        w[j] = c * (inverse[j] * strain[j]);
+        we[j] = c * r * (inverse[j] * strain[j]) * (1.0 + eta[j]);
       }
-      for (long l = 0; l + 1 < m; ++l)
-        grad[l] =
-            (zeta[l] * (7.0 * strain[l / r]) - zeta[l + 1] * (7.0 * strain[(l + 1) / r])) * 100.0;
+      for (long l = 0; l + 1 < m; ++l) {
+        const long j = l / r;
+        gu[l] = (l + 1) % r != 0 ? ((up[l] - 2.0 * up[l + 1]) + up[l + 2]) * (-w[j] * (invH * invH))
+                                 : (zeta[l] * w[j] - zeta[l + 1] * w[j + 1]) * invH;
+      }
+      for (long j = 0; j + 1 < mv; ++j) gv[j] = (we[j] - we[j + 1]) * invHv;
+      const double end = tension * eta[mv - 1] + we[mv - 1] * invHv;
+      std::vector<double> fenced(kMaxLanes, NAN);
+      fenced.insert(fenced.end(), u.begin(), u.end());
+      fenced.resize(fenced.size() + kMaxLanes, NAN);
+      const double* inPlace = fenced.data() + kMaxLanes;
       for (const Kernels* k : paths) {
-        // gu is followed by the caller's other coordinates, which fineForces must leave alone.
-        std::vector<double> scratch(m + kMaxLanes, NAN), z(m + kMaxLanes, NAN), s(mv), i(mv),
-            g(m - 1 + kMaxLanes, -1.0);
-        k->cellStretches(up.data(), eta.data(), mv, r, 100.0, z.data(), s.data(), i.data());
-        EXPECT_TRUE(std::equal(zeta.begin(), zeta.end(), z.begin())) << k->name << " r " << r;
+        std::vector<double> s(mv), i(mv);
+        k->cellStretches(up.data(), eta.data(), mv, r, invH, s.data(), i.data());
         EXPECT_EQ(s, strain) << k->name << " r = " << r << " mv = " << mv;
         EXPECT_EQ(i, inverse) << k->name << " r = " << r << " mv = " << mv;
-        k->fineForces(mv, r, 7.0, 100.0, s.data(), scratch.data(), z.data(), g.data());
-        EXPECT_TRUE(std::equal(grad.begin(), grad.end(), g.begin()))
+        // The work starts as garbage; gu and gv are followed by coordinates to leave alone.
+        std::vector<double> work(twoGridWork(m, mv), NAN), g(m - 1 + kMaxLanes, -1.0),
+            h(mv - 1 + kMaxLanes, -1.0);
+        const TwoGridSums sums = k->twoGridForces(inPlace, v.data(), mv, r, invH, invHv, c, tension,
+                                                  work.data(), g.data(), h.data());
+        EXPECT_EQ(sums.squaredStrains, sum) << k->name << " r = " << r << " mv = " << mv;
+        EXPECT_EQ(sums.endTension, end) << k->name << " r = " << r << " mv = " << mv;
+        EXPECT_TRUE(std::equal(gu.begin(), gu.end(), g.begin()))
+            << k->name << " r = " << r << " mv = " << mv;
+        EXPECT_TRUE(std::equal(gv.begin(), gv.end(), h.begin()))
             << k->name << " r = " << r << " mv = " << mv;
         EXPECT_TRUE(std::all_of(g.begin() + (m - 1), g.end(), [](double x) { return x == -1.0; }))
-            << k->name << " wrote past its last segment, r = " << r << " mv = " << mv;
+            << k->name << " wrote past u's last node, r = " << r << " mv = " << mv;
+        EXPECT_TRUE(std::all_of(h.begin() + (mv - 1), h.end(), [](double x) { return x == -1.0; }))
+            << k->name << " wrote past v's last node, r = " << r << " mv = " << mv;
       }
     }
   }
