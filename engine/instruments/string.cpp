@@ -51,12 +51,12 @@ NonlinearString::NonlinearString(const StringPhysics& p, StringGrid grid)
   inverseMass_.resize(nu + nv);
   inverseMass_.head(nu).setConstant(1.0 / (p.linearDensity() * h_));
   inverseMass_.tail(nv).setConstant(1.0 / (p.linearDensity() * hv_));
-  // The two grids' kernels run in whole chunks past the last segment (kernels.h).
-  work1_.setZero(grid.transverse + kMaxLanes);
+  work1_.setZero(grid.transverse);
   work2_.setZero(grid.transverse);
+  // cellStretches runs in whole chunks past the last segment (kernels.h).
   work3_.setZero(grid.transverse + kMaxLanes);
   for (Vector* w : {&cell1_, &cell2_, &cell3_}) w->setZero(grid.longitudinal);
-  scratch_.setZero(grid.transverse + kMaxLanes);
+  scratch_.setZero(grid.transverse + 1);
   if (ratio_ > 1 && grid.longitudinal > 1)
     forcesWork_.setZero(twoGridWork(grid.transverse, grid.longitudinal));
   d2_.setZero(nu);
@@ -204,14 +204,14 @@ void NonlinearString::applyStiffnessAndLoss(const Vector& q, const Vector& qPrev
                              physics_.young * physics_.inertia * h_,
                              -rhoA * lossWeights_.transverse * h_);
   d2_.swap(d2Prev_);
-  if (ratio_ > 1 && grid_.longitudinal <= kMaxLanes)
+  if (ratio_ > 1 && grid_.longitudinal <= kFewCoarseCells)
     return coarseStiffnessAndLoss(q, qPrev, kq, cq);
   longitudinalStiffness(q, kq);
   longitudinalLoss(q, qPrev, cq);
 }
 
 // longitudinalStiffness and longitudinalLoss in one sweep over the few coarse nodes of the two
-// grids' shorter strings (Mv − 1 < kMaxLanes: F3 and up), where two kernel calls and a vector
+// grids' shorter strings (Mv <= kFewCoarseCells: F3 and up), where two kernel calls and a vector
 // expression cost more than the sweep (C5: 3.5 % of a key; on A0's 42 nodes the kernels are 2–4 %
 // faster); the same operations, v = 0 beyond both ends.
 void NonlinearString::coarseStiffnessAndLoss(const Vector& q, const Vector& qPrev, Vector& kq,
@@ -364,7 +364,7 @@ NonlinearString::OneCell NonlinearString::oneCell(const Vector& q) const {
 
 // Its gradient, the two grids' with r = M and η = 0: ∂V'/∂ζ_l = c (ε/S) ζ_l, so
 // ∇_u V' = D₋ᵀ(c (ε/S) ζ) = c (ε/S) (2u_j − u_{j−1} − u_{j+1}) / h²: with oneCell's, two sweeps
-// where the cells' kernels take four and a copy; the tension at the end, c M ε/(S h_v).
+// where the cells' kernel takes a copy and three; the tension at the end, c M ε/(S h_v).
 double NonlinearString::oneCellGradient(const Vector& q, Vector& grad) const {
   const Eigen::Index m = segments_;
   const double* u = q.data();

@@ -165,10 +165,11 @@ class NonlinearString {
   bool linearised_ = false;
   LossWeights lossWeights_;
   mutable double endTension_ = 0.0;
-  // Work of the stencils and the potentials, per fine segment (size Mu): work1_ the stiffness
-  // stencil's D2 u and, with work2_, the single grid's ∂V'/∂ζ and ∂V'/∂η; work3_ u padded with its
-  // fixed ends (Mu + 1, then zeros); scratch_ the single grid's padded v. Per coarse cell (Mv):
-  // cell1_ … cell3_. forcesWork_: the two grids' gradient's (Kernels::twoGridForces).
+  // Work of the stencils and the potentials, per fine segment: work1_ the stiffness stencil's D2 u
+  // and, with work2_, the single grid's ∂V'/∂ζ and ∂V'/∂η (Mu each); work3_ u padded with its
+  // fixed ends for cellStretches (Mu + 1, then zeros to Mu + kMaxLanes); scratch_ the single grid's
+  // padded v (Mu + 1). Per coarse cell (Mv): cell1_ … cell3_. forcesWork_: the two grids'
+  // gradient's (Kernels::twoGridForces).
   mutable Vector work1_, work2_, work3_, cell1_, cell2_, cell3_;
   mutable Vector scratch_, forcesWork_;
   mutable Vector d2_, d2Prev_;  // D2 u/h² of applyStiffnessAndLoss's q and of the one before
@@ -197,6 +198,10 @@ double minimalSpacing(const StringPhysics& physics, GridRule rule, double k, dou
 // or the string is too short for two segments.
 int gridSegments(const StringPhysics& physics, GridRule rule, double k, double sigma1,
                  double factor);
+
+// The coarse cells up to which the two grids' v takes one sweep for its stiffness and loss
+// (NonlinearString::coarseStiffnessAndLoss) rather than the kernels: measured, not derived.
+constexpr int kFewCoarseCells = 8;
 
 // v's spacing on the two grids as a multiple of sqrt(E/ρ) k: the longitudinal Courant number is
 // 1/1.05 (SCHEMES §3b; at 1.43 the glide collapses to a quarter of the converged one).

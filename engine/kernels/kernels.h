@@ -15,7 +15,7 @@ constexpr int kMaxLanes = 8;  // doubles in the widest vector register (AVX-512)
 
 struct TwoGridSums {
   double squaredStrains;  // Σ_J ε_J²
-  double endTension;      // N, at the string's last segment
+  double endTension;      // N beyond T0, at the string's far end
 };
 // The doubles of twoGridForces' work on m fine segments and mv coarse cells.
 constexpr long twoGridWork(long m, long mv) { return m + kMaxLanes + 3 * mv; }
@@ -32,15 +32,15 @@ struct Kernels {
   // four segments past the last one: up holds m + kMaxLanes values (finite: zeros past u_m).
   void (*cellStretches)(const double* up, const double* eta, long mv, int r, double invH,
                         double* strain, double* inverseStretch);
-  // The two grids' gradient in one call (NonlinearString::twoGridGradient): from u (m − 1 values,
-  // m = mv r, u_0 = u_m = 0) and v (mv − 1), η_J = (D₋v)_J, cellStretches' strains, the weights
-  // w_J = c ε_J/S_J of ∂V'/∂ζ_l = w_J ζ_l and ∂V'/∂η_J = c r (ε_J/S_J)(1 + η_J), then
-  // gu = D₋ᵀ(∂V'/∂ζ) (m − 1 values: −w_J (u_{l−1} − 2u_l + u_{l+1}) invH² inside a cell, and
-  // (w_J ζ_l − w_{J+1} ζ_{l+1}) invH at its last node) and gv = D₋ᵀ(∂V'/∂η) invHv (mv − 1).
-  // work: twoGridWork(m, mv) doubles (u is copied there with its ends); nothing past u's m − 1
-  // values is read. Returns Σ_J ε_J² and the
-  // end's tension T η_{mv−1} + (∂V'/∂η)_{mv−1} invHv. The same bits on every path, as
-  // cellStretches'.
+  // The two grids' gradient in one call (NonlinearString::twoGridGradient): from u (nodes 1 …
+  // m − 1 at u[0 … m − 2], m = mv r, the ends u_0 = u_m = 0 not stored; nothing past them is read)
+  // and v (mv − 1), η_J = (D₋v)_J, cellStretches' strains, the weights w_J = c ε_J/S_J of
+  // ∂V'/∂ζ_l = w_J ζ_l and ∂V'/∂η_J = c r (ε_J/S_J)(1 + η_J), then gu = D₋ᵀ(∂V'/∂ζ) (at node i,
+  // gu[i − 1]: −w_J (u_{i−1} − 2u_i + u_{i+1}) invH² where segments i − 1 and i lie in cell J,
+  // (w_J ζ_{i−1} − w_{J+1} ζ_i) invH where segment i − 1 is J's last) and gv = D₋ᵀ(∂V'/∂η) on the
+  // coarse grid (mv − 1). work: twoGridWork(m, mv) doubles, u copied there with its ends. Returns
+  // Σ_J ε_J² and the end's pull beyond T0, T0 η_{mv−1} + (∂V'/∂η)_{mv−1} invHv
+  // (NonlinearString::endTension). The same bits on every path, as cellStretches'.
   TwoGridSums (*twoGridForces)(const double* u, const double* v, long mv, int r, double invH,
                                double invHv, double c, double tension, double* work, double* gu,
                                double* gv);

@@ -304,46 +304,56 @@ TEST(NonlinearString, LossOperatorIsMinusRhoAhD2OfTheDifference) {
 // applyLossOperator give them, the loss's D2 qPrev/h² taken afresh or kept from the call before
 // (prevKept), with u bent (K's β) and v's own law. C's u part is cl (d2(q) − d2(qPrev)) for the
 // stencil's D2(q − qPrev)/h²: each d2 carries a few roundings of its own magnitude (four
-// operations:
-// <= 4 ulp), so the two differ by at most 8ε max|cl d2|; ask 16ε. K q is the same arithmetic.
+// operations: <= 4 ulp), so the two differ by at most 8ε max|cl d2|; ask 16ε. K q is the same
+// arithmetic. v's parts are the same operations, bit for bit, on every grid — those of up to
+// kFewCoarseCells cells take one sweep of their own (coarseStiffnessAndLoss) — with and without
+// the constant loss weight, and linearised (v's stiffness EA).
 TEST(NonlinearString, TheStiffnessSweepsLossIsTheLossOperator) {
-  for (const StringGrid grid : {StringGrid{24, 24}, StringGrid{24, 4}, StringGrid{24, 1}}) {
-    NonlinearString string(c3(), grid);
-    string.setLossWeights({0.5, 3.0, 2.0});
-    string.setTensionRange(1.2);
-    string.setTensionScale(1.1);
-    const Eigen::Index n = string.size(), nu = grid.transverse - 1;
-    const Vector q0 = randomVector(n, 1e-3, 11), q1 = randomVector(n, 1e-3, 12),
-                 q2 = q1 + randomVector(n, 1e-6, 13);  // a step's small change
-    Vector kq(n), cq(n), kqRef(n), cqRef(n);
-    const double h = string.spacing(), rhoA = c3().linearDensity();
-    auto expectBoth = [&](const Vector& q, const Vector& qPrev, bool prevKept) {
-      string.applyStiffnessAndLoss(q, qPrev, prevKept, kq, cq);
-      string.applyStiffness(q, kqRef);
-      string.applyLossOperator(q, qPrev, cqRef);
-      EXPECT_LE((kq - kqRef).cwiseAbs().maxCoeff(), 1e-15 * kqRef.cwiseAbs().maxCoeff());
-      auto d2Max = [&](const Vector& x) {  // max |D2 x/h²| on u
-        double top = 0.0;
-        for (Eigen::Index j = 0; j < nu; ++j)
-          top = std::max(
-              top, std::abs((j > 0 ? x[j - 1] : 0.0) - 2.0 * x[j] + (j + 1 < nu ? x[j + 1] : 0.0)) /
-                       (h * h));
-        return top;
-      };
-      const double scale = 0.5 * rhoA * h * std::max(d2Max(q), d2Max(qPrev));  // |cl| max |d2|
-      EXPECT_LE((cq - cqRef).head(nu).cwiseAbs().maxCoeff(),
-                16.0 * std::numeric_limits<double>::epsilon() * scale)
-          << grid.longitudinal << (prevKept ? " kept" : " taken");
-      EXPECT_EQ(cq.tail(n - nu), cqRef.tail(n - nu)) << "v's part: the same stencil";
-    };
-    expectBoth(q1, q0, false);  // D2 q0 taken here
-    expectBoth(q2, q1, true);   // D2 q1 kept from the call before
-    // Kept means the same bits as taken afresh.
-    Vector kept = cq;
-    string.applyStiffnessAndLoss(q1, q0, false, kq, cq);
-    string.applyStiffnessAndLoss(q2, q1, false, kq, cq);
-    EXPECT_EQ(kept, cq);
-  }
+  for (const StringGrid grid :
+       {StringGrid{24, 24}, StringGrid{24, 12}, StringGrid{24, 8}, StringGrid{24, 4},
+        StringGrid{24, 3}, StringGrid{24, 2}, StringGrid{24, 1}})
+    for (const NonlinearString::LossWeights weights :
+         {NonlinearString::LossWeights{0.5, 3.0, 2.0}, NonlinearString::LossWeights{0.5, 0.0, 2.0}})
+      for (const bool linear : {false, true}) {
+        NonlinearString string(c3(), grid);
+        string.setLossWeights(weights);
+        string.setLinearised(linear);
+        string.setTensionRange(1.2);
+        string.setTensionScale(1.1);
+        const Eigen::Index n = string.size(), nu = grid.transverse - 1;
+        const Vector q0 = randomVector(n, 1e-3, 11), q1 = randomVector(n, 1e-3, 12),
+                     q2 = q1 + randomVector(n, 1e-6, 13);  // a step's small change
+        Vector kq(n), cq(n), kqRef(n), cqRef(n);
+        const double h = string.spacing(), rhoA = c3().linearDensity();
+        auto expectBoth = [&](const Vector& q, const Vector& qPrev, bool prevKept) {
+          string.applyStiffnessAndLoss(q, qPrev, prevKept, kq, cq);
+          string.applyStiffness(q, kqRef);
+          string.applyLossOperator(q, qPrev, cqRef);
+          EXPECT_LE((kq - kqRef).cwiseAbs().maxCoeff(), 1e-15 * kqRef.cwiseAbs().maxCoeff());
+          EXPECT_EQ(kq.tail(n - nu), kqRef.tail(n - nu))
+              << "v's stiffness: the same stencil, " << grid.longitudinal << " cells";
+          auto d2Max = [&](const Vector& x) {  // max |D2 x/h²| on u
+            double top = 0.0;
+            for (Eigen::Index j = 0; j < nu; ++j)
+              top = std::max(top, std::abs((j > 0 ? x[j - 1] : 0.0) - 2.0 * x[j] +
+                                           (j + 1 < nu ? x[j + 1] : 0.0)) /
+                                      (h * h));
+            return top;
+          };
+          const double scale = 0.5 * rhoA * h * std::max(d2Max(q), d2Max(qPrev));  // |cl| max |d2|
+          EXPECT_LE((cq - cqRef).head(nu).cwiseAbs().maxCoeff(),
+                    16.0 * std::numeric_limits<double>::epsilon() * scale)
+              << grid.longitudinal << (prevKept ? " kept" : " taken");
+          EXPECT_EQ(cq.tail(n - nu), cqRef.tail(n - nu)) << "v's part: the same stencil";
+        };
+        expectBoth(q1, q0, false);  // D2 q0 taken here
+        expectBoth(q2, q1, true);   // D2 q1 kept from the call before
+        // Kept means the same bits as taken afresh.
+        Vector kept = cq;
+        string.applyStiffnessAndLoss(q1, q0, false, kq, cq);
+        string.applyStiffnessAndLoss(q2, q1, false, kq, cq);
+        EXPECT_EQ(kept, cq);
+      }
 }
 
 // Each wave its own law: with weights (w_u, w_v0, w_v1), M⁻¹C is w_u (−D2) on u and w_v0 + w_v1
