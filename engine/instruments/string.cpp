@@ -53,8 +53,7 @@ NonlinearString::NonlinearString(const StringPhysics& p, StringGrid grid)
   inverseMass_.tail(nv).setConstant(1.0 / (p.linearDensity() * hv_));
   work1_.setZero(grid.transverse);
   work2_.setZero(grid.transverse);
-  // cellStretches runs in whole chunks past the last segment (kernels.h).
-  work3_.setZero(grid.transverse + kMaxLanes);
+  work3_.setZero(grid.transverse + 1);
   for (Vector* w : {&cell1_, &cell2_, &cell3_}) w->setZero(grid.longitudinal);
   scratch_.setZero(grid.transverse + 1);
   if (ratio_ > 1 && grid.longitudinal > 1)
@@ -296,17 +295,6 @@ double NonlinearString::singleGridPotential(const Vector& q) const {
 
 namespace {
 
-// η_J = (v_J − v_{J−1}) / h_v on the Mv coarse cells, v = 0 beyond both ends.
-void longitudinalStrains(const double* v, Eigen::Index mv, double invHv, double* eta) {
-  if (mv == 1) {
-    eta[0] = 0.0;
-    return;
-  }
-  eta[0] = v[0] * invHv;
-  eta[mv - 1] = -v[mv - 2] * invHv;
-  for (Eigen::Index j = 1; j < mv - 1; ++j) eta[j] = (v[j] - v[j - 1]) * invHv;
-}
-
 // u (or v) with its fixed ends, up[0] = up[M] = 0, so that ζ_l = (up[l+1] − up[l]) / h on every
 // segment.
 void padded(const double* u, Eigen::Index m, double* up) {
@@ -334,11 +322,9 @@ double NonlinearString::singleGridGradient(const Vector& q, Vector& grad) const 
 // ε_J = S_J − 1 into strain_J and 1/S_J into inverseStretch_J, S_J = sqrt((1 + η_J)² + Z_J)
 // (docs/string-grids.md, "The strain of a cell").
 void NonlinearString::cellStrains(const Vector& q, double* strain, double* inverseStretch) const {
-  const Eigen::Index m = segments_, mv = grid_.longitudinal;
-  padded(q.data(), m, work3_.data());
-  longitudinalStrains(q.data() + (m - 1), mv, 1.0 / hv_, cell1_.data());
-  kernels_->cellStretches(work3_.data(), cell1_.data(), mv, ratio_, 1.0 / h_, strain,
-                          inverseStretch);
+  const Eigen::Index m = segments_;
+  kernels_->cellStretches(q.data(), q.data() + (m - 1), grid_.longitudinal, ratio_, 1.0 / h_,
+                          1.0 / hv_, forcesWork_.data(), strain, inverseStretch);
 }
 
 // One coarse cell (Mv = 1: the strings shorter than 2.1 √(E/ρ) k, the Kirchhoff–Carrier limit of

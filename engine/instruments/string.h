@@ -166,10 +166,10 @@ class NonlinearString {
   LossWeights lossWeights_;
   mutable double endTension_ = 0.0;
   // Work of the stencils and the potentials, per fine segment: work1_ the stiffness stencil's D2 u
-  // and, with work2_, the single grid's ∂V'/∂ζ and ∂V'/∂η (Mu each); work3_ u padded with its
-  // fixed ends for cellStretches (Mu + 1, then zeros to Mu + kMaxLanes); scratch_ the single grid's
-  // padded v (Mu + 1). Per coarse cell (Mv): cell1_ … cell3_. forcesWork_: the two grids'
-  // gradient's (Kernels::twoGridForces).
+  // and, with work2_, the single grid's ∂V'/∂ζ and ∂V'/∂η (Mu each); work3_ and scratch_ the
+  // single grid's u and v padded with their fixed ends (Mu + 1 each; work3_ also the quasi-static
+  // stretch's u). Per coarse cell (Mv): cell1_ … cell3_. forcesWork_: the two grids' kernels'
+  // (Kernels::cellStretches, twoGridForces).
   mutable Vector work1_, work2_, work3_, cell1_, cell2_, cell3_;
   mutable Vector scratch_, forcesWork_;
   mutable Vector d2_, d2Prev_;  // D2 u/h² of applyStiffnessAndLoss's q and of the one before

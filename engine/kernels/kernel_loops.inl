@@ -23,8 +23,21 @@ constexpr int kChunk = 4;
 // Four doubles: one vector register on AVX2 and AVX-512, two on SSE2.
 typedef double Chunk __attribute__((vector_size(kChunk * sizeof(double))));
 
-HAMILTONE_TARGET void cellStretches(const double* up, const double* eta, long mv, int r,
-                                    double invH, double* strain, double* inverseStretch) {
+// u padded with its ends and η into work (twoGridStrainsWork), then the cells' stretches.
+HAMILTONE_TARGET void cellStretches(const double* u, const double* v, long mv, int r, double invH,
+                                    double invHv, double* work, double* strain,
+                                    double* inverseStretch) {
+  const long m = mv * r;
+  double* up = work;                   // u with its fixed ends, then zeros
+  double* eta = up + (m + kMaxLanes);  // η_J
+  up[0] = 0.0;
+  long i = 0;
+  for (; i + kChunk <= m - 1; i += kChunk) __builtin_memcpy(up + 1 + i, u + i, sizeof(Chunk));
+  for (; i < m - 1; ++i) up[1 + i] = u[i];
+  for (long l = m; l < m + kMaxLanes; ++l) up[l] = 0.0;
+  eta[0] = mv == 1 ? 0.0 : v[0] * invHv;  // v = 0 beyond both ends
+  for (long j = 1; j < mv - 1; ++j) eta[j] = (v[j] - v[j - 1]) * invHv;
+  if (mv > 1) eta[mv - 1] = -v[mv - 2] * invHv;
   const Chunk position = {0.0, 1.0, 2.0, 3.0}, zero = {};
   const double invR = 1.0 / r;
   double* meanSquare = strain;  // Z_J, until the last loop
@@ -58,19 +71,11 @@ HAMILTONE_TARGET TwoGridSums twoGridForces(const double* u, const double* v, lon
                                            double invH, double invHv, double c, double tension,
                                            double* work, double* gu, double* gv) {
   const long m = mv * r;
-  double* up = work;                   // u with its fixed ends, then zeros
-  double* eta = up + (m + kMaxLanes);  // η_J
-  double* strain = eta + mv;           // ε_J, then ∂V'/∂η_J
-  double* weight = strain + mv;        // 1/S_J, then c ε_J/S_J
-  up[0] = 0.0;
-  long t = 0;
-  for (; t + kChunk <= m - 1; t += kChunk) __builtin_memcpy(up + 1 + t, u + t, sizeof(Chunk));
-  for (; t < m - 1; ++t) up[1 + t] = u[t];
-  for (long l = m; l < m + kMaxLanes; ++l) up[l] = 0.0;
-  eta[0] = mv == 1 ? 0.0 : v[0] * invHv;  // v = 0 beyond both ends
-  for (long j = 1; j < mv - 1; ++j) eta[j] = (v[j] - v[j - 1]) * invHv;
-  if (mv > 1) eta[mv - 1] = -v[mv - 2] * invHv;
-  cellStretches(up, eta, mv, r, invH, strain, weight);
+  const double* up = work;                       // u with its fixed ends, then zeros
+  const double* eta = up + (m + kMaxLanes);      // η_J
+  double* strain = work + (m + kMaxLanes + mv);  // ε_J, then ∂V'/∂η_J
+  double* weight = strain + mv;                  // 1/S_J, then c ε_J/S_J
+  cellStretches(u, v, mv, r, invH, invHv, work, strain, weight);
   const double cr = c * r;
   double sum = 0.0;
   for (long j = 0; j < mv; ++j) {

@@ -17,28 +17,30 @@ struct TwoGridSums {
   double squaredStrains;  // Σ_J ε_J²
   double endTension;      // N beyond T0, at the string's far end
 };
-// The doubles of twoGridForces' work on m fine segments and mv coarse cells.
-constexpr long twoGridWork(long m, long mv) { return m + kMaxLanes + 3 * mv; }
+// The doubles of cellStretches' and twoGridForces' work on m fine segments and mv coarse cells.
+constexpr long twoGridStrainsWork(long m, long mv) { return m + kMaxLanes + mv; }
+constexpr long twoGridWork(long m, long mv) { return twoGridStrainsWork(m, mv) + 2 * mv; }
 
 struct Kernels {
   Isa isa;
   const char* name;
-  // The two grids' strains (docs/string-grids.md): with up the padded u (u_0 = u_m = 0, m = mv r)
-  // and η_J the coarse strains, each fine segment's slope ζ_l = (up[l+1] − up[l]) invH, each
-  // cell's mean square slope Z_J = (1/r) Σ_{l∈J} ζ_l² (four partial sums over l ≡ 0, 1, 2, 3
-  // (mod 4) from the cell's first segment, added as (p0 + p1) + (p2 + p3) on every path), its
-  // stretch S_J = sqrt((1 + η_J)² + Z_J), strain_J = S_J − 1 (as (2η + η² + Z)/(S + 1): no
-  // cancellation at small strain) and inverseStretch_J = 1/S_J. The loops run in whole chunks of
-  // four segments past the last one: up holds m + kMaxLanes values (finite: zeros past u_m).
-  void (*cellStretches)(const double* up, const double* eta, long mv, int r, double invH,
-                        double* strain, double* inverseStretch);
-  // The two grids' gradient in one call (NonlinearString::twoGridGradient): from u (nodes 1 …
-  // m − 1 at u[0 … m − 2], m = mv r, the ends u_0 = u_m = 0 not stored; nothing past them is read)
-  // and v (mv − 1), η_J = (D₋v)_J, cellStretches' strains, the weights w_J = c ε_J/S_J of
+  // The two grids' strains (docs/string-grids.md): from u (nodes 1 … m − 1 at u[0 … m − 2],
+  // m = mv r, the ends u_0 = u_m = 0 not stored; nothing past them is read) and v (mv − 1), u
+  // with its ends into work (m + kMaxLanes values, zeros past u_m) and η_J = (D₋v)_J after it
+  // (mv values: twoGridStrainsWork(m, mv) in all); then each fine segment's slope
+  // ζ_l = (u_{l+1} − u_l) invH, each cell's mean square slope Z_J = (1/r) Σ_{l∈J} ζ_l² (four
+  // partial sums over l ≡ 0, 1, 2, 3 (mod 4) from the cell's first segment, added as
+  // (p0 + p1) + (p2 + p3) on every path), its stretch S_J = sqrt((1 + η_J)² + Z_J),
+  // strain_J = S_J − 1 (as (2η + η² + Z)/(S + 1): no cancellation at small strain) and
+  // inverseStretch_J = 1/S_J.
+  void (*cellStretches)(const double* u, const double* v, long mv, int r, double invH, double invHv,
+                        double* work, double* strain, double* inverseStretch);
+  // The two grids' gradient in one call (NonlinearString::twoGridGradient): from u and v as
+  // cellStretches takes them, its strains, the weights w_J = c ε_J/S_J of
   // ∂V'/∂ζ_l = w_J ζ_l and ∂V'/∂η_J = c r (ε_J/S_J)(1 + η_J), then gu = D₋ᵀ(∂V'/∂ζ) (at node i,
   // gu[i − 1]: −w_J (u_{i−1} − 2u_i + u_{i+1}) invH² where segments i − 1 and i lie in cell J,
   // (w_J ζ_{i−1} − w_{J+1} ζ_i) invH where segment i − 1 is J's last) and gv = D₋ᵀ(∂V'/∂η) on the
-  // coarse grid (mv − 1). work: twoGridWork(m, mv) doubles, u copied there with its ends. Returns
+  // coarse grid (mv − 1). work: twoGridWork(m, mv) doubles, cellStretches' first. Returns
   // Σ_J ε_J² and the end's pull beyond T0, T0 η_{mv−1} + (∂V'/∂η)_{mv−1} invHv
   // (NonlinearString::endTension). The same bits on every path, as cellStretches'.
   TwoGridSums (*twoGridForces)(const double* u, const double* v, long mv, int r, double invH,

@@ -93,9 +93,9 @@ TEST(Kernels, StencilsAndForcesAreBitIdenticalOnEveryPath) {
 // The two grids' strains and forces, r fine segments a cell (chunks ending inside a cell, on its
 // edge, several cells to a chunk at r = 1), strains η ~ 1e-4, every buffer exactly the size
 // kernels.h asks: each path, the portable one too, gives the bits of the formulas written out
-// here, so the same bits on every path. twoGridForces' u sits after NaNs, which a read before
-// its first node would carry into the results (past its last, the kernel reads by construction
-// nothing: its copy loads whole chunks only within u, then the ends).
+// here, so the same bits on every path. u sits after NaNs, which a read before its first node
+// would carry into the results (past its last, the kernels read by construction nothing: their
+// copy loads whole chunks only within u, then the ends), and the work starts as NaNs too.
 TEST(Kernels, TwoGridStrainsAndForcesAreTheFormulasOnEveryPath) {
   std::vector<const Kernels*> paths = otherPaths();
   paths.push_back(&kernelsFor(Isa::portable));
@@ -136,8 +136,9 @@ TEST(Kernels, TwoGridStrainsAndForcesAreTheFormulasOnEveryPath) {
       fenced.resize(fenced.size() + kMaxLanes, NAN);
       const double* inPlace = fenced.data() + kMaxLanes;
       for (const Kernels* k : paths) {
-        std::vector<double> s(mv), i(mv);
-        k->cellStretches(up.data(), eta.data(), mv, r, invH, s.data(), i.data());
+        std::vector<double> s(mv), i(mv), strainsWork(twoGridStrainsWork(m, mv), NAN);
+        k->cellStretches(inPlace, v.data(), mv, r, invH, invHv, strainsWork.data(), s.data(),
+                         i.data());
         EXPECT_EQ(s, strain) << k->name << " r = " << r << " mv = " << mv;
         EXPECT_EQ(i, inverse) << k->name << " r = " << r << " mv = " << mv;
         // The work starts as garbage; gu and gv are followed by coordinates to leave alone.
