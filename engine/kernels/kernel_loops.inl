@@ -23,6 +23,26 @@ constexpr int kChunk = 4;
 // Four doubles: one vector register on AVX2 and AVX-512, two on SSE2.
 typedef double Chunk __attribute__((vector_size(kChunk * sizeof(double))));
 
+// One vector register of doubles (GCC's vector extension, so that the loops below are vectorised
+// as written, whatever the compiler's cost model).
+typedef double Lanes __attribute__((vector_size(kLanes * sizeof(double))));
+
+// A register's lanes summed as a tree: halves, then quarters, … (the order of every call on a
+// path).
+HAMILTONE_TARGET inline double laneSum(Lanes s) {
+  double lane[kLanes];
+  __builtin_memcpy(lane, &s, sizeof s);
+  for (int width = kLanes / 2; width > 0; width /= 2)
+    for (int i = 0; i < width; ++i) lane[i] += lane[i + width];
+  return lane[0];
+}
+
+HAMILTONE_TARGET inline Lanes loadLanes(const double* p) {
+  Lanes x;
+  __builtin_memcpy(&x, p, sizeof x);
+  return x;
+}
+
 // u padded with its ends and η into work (twoGridStrainsWork), then the cells' stretches.
 HAMILTONE_TARGET void cellStretches(const double* u, const double* v, long mv, int r, double invH,
                                     double invHv, double* work, double* strain,
@@ -108,19 +128,43 @@ HAMILTONE_TARGET TwoGridSums twoGridForces(const double* u, const double* v, lon
   return {sum, tension * eta[mv - 1] + strain[mv - 1] * invHv};
 }
 
+// One segment's weights (T: double or Lanes), its excess S − 1 returned.
+template <class T>
+HAMILTONE_TARGET inline T segmentWeights(T zeta, T eta, T sqrtStretch(T), double c, T& wz, T& we) {
+  const T stretch = sqrtStretch((1.0 + eta) * (1.0 + eta) + zeta * zeta);
+  const T excess = (2.0 * eta + eta * eta + zeta * zeta) / (stretch + 1.0);
+  const T phi = excess / stretch;
+  wz = c * phi * zeta;
+  we = c * phi * (1.0 + eta);
+  return excess;
+}
+HAMILTONE_TARGET inline double scalarSqrt(double x) { return __builtin_sqrt(x); }
+HAMILTONE_TARGET inline Lanes lanesSqrt(Lanes x) {
+  for (int i = 0; i < kLanes; ++i) x[i] = __builtin_sqrt(x[i]);
+  return x;
+}
+
+// Whole registers, the sum kept as lanes (savDotsOf's reason), then the last segments one by one.
 HAMILTONE_TARGET double singleGridForces(const double* up, const double* vp, long m, double invH,
                                          double c, double* wz, double* we, double* gu, double* gv) {
+  Lanes sums = {};
+  long l = 0;
+  for (; l + kLanes <= m; l += kLanes) {
+    Lanes z, e;
+    const Lanes excess = segmentWeights<Lanes>((loadLanes(up + l + 1) - loadLanes(up + l)) * invH,
+                                               (loadLanes(vp + l + 1) - loadLanes(vp + l)) * invH,
+                                               lanesSqrt, c, z, e);
+    __builtin_memcpy(wz + l, &z, sizeof z);
+    __builtin_memcpy(we + l, &e, sizeof e);
+    sums += excess * excess;
+  }
   double sum = 0.0;
-#pragma omp simd reduction(+ : sum)
-  for (long l = 0; l < m; ++l) {
-    const double zeta = (up[l + 1] - up[l]) * invH, eta = (vp[l + 1] - vp[l]) * invH;
-    const double stretch = __builtin_sqrt((1.0 + eta) * (1.0 + eta) + zeta * zeta);
-    const double excess = (2.0 * eta + eta * eta + zeta * zeta) / (stretch + 1.0);
-    const double phi = excess / stretch;
-    wz[l] = c * phi * zeta;
-    we[l] = c * phi * (1.0 + eta);
+  for (; l < m; ++l) {
+    const double excess = segmentWeights<double>(
+        (up[l + 1] - up[l]) * invH, (vp[l + 1] - vp[l]) * invH, scalarSqrt, c, wz[l], we[l]);
     sum += excess * excess;
   }
+  sum += laneSum(sums);
 #pragma omp simd
   for (long j = 0; j < m - 1; ++j) {
     gu[j] = (wz[j] - wz[j + 1]) * invH;
@@ -189,20 +233,33 @@ HAMILTONE_TARGET void secondDifferenceOfDifference(const double* a, const double
   out[n - 1] = c * ((a[n - 2] - b[n - 2]) - 2.0 * (a[n - 1] - b[n - 1]));
 }
 
+// Whole registers, the five sums kept as lanes and each added once at the end as a tree; then the
+// coordinates past the last whole register one by one. (An `omp simd` reduction here left GCC's
+// partial sums on the stack and added them lane by lane: half the kernel's time on a short string.)
 template <bool stiff, bool extra>
 HAMILTONE_TARGET void savDotsOf(long n, const double* g, const double* q, const double* qm,
                                 const double* minv, const double* kq, const double* x,
                                 double xScale, double out[5]) {
-  double sq = 0.0, sqm = 0.0, sMKq = 0.0, sMx = 0.0, sMg = 0.0;
-#pragma omp simd reduction(+ : sq, sqm, sMKq, sMx, sMg)
-  for (long i = 0; i < n; ++i) {
-    sq += g[i] * q[i];
-    sqm += g[i] * qm[i];
-    if constexpr (stiff) sMKq += g[i] * (minv[i] * kq[i]);
-    if constexpr (extra) sMx += g[i] * (minv[i] * (xScale * x[i]));
-    sMg += g[i] * minv[i] * g[i];
+  Lanes sq = {}, sqm = {}, sMKq = {}, sMx = {}, sMg = {};
+  long i = 0;
+  for (; i + kLanes <= n; i += kLanes) {
+    const Lanes gi = loadLanes(g + i), mi = loadLanes(minv + i);
+    sq += gi * loadLanes(q + i);
+    sqm += gi * loadLanes(qm + i);
+    if constexpr (stiff) sMKq += gi * (mi * loadLanes(kq + i));
+    if constexpr (extra) sMx += gi * (mi * (xScale * loadLanes(x + i)));
+    sMg += gi * mi * gi;
   }
-  out[0] = sq, out[1] = sqm, out[2] = sMKq, out[3] = sMx, out[4] = sMg;
+  double tq = 0.0, tqm = 0.0, tMKq = 0.0, tMx = 0.0, tMg = 0.0;
+  for (; i < n; ++i) {
+    tq += g[i] * q[i];
+    tqm += g[i] * qm[i];
+    if constexpr (stiff) tMKq += g[i] * (minv[i] * kq[i]);
+    if constexpr (extra) tMx += g[i] * (minv[i] * (xScale * x[i]));
+    tMg += g[i] * minv[i] * g[i];
+  }
+  out[0] = laneSum(sq) + tq, out[1] = laneSum(sqm) + tqm, out[2] = laneSum(sMKq) + tMKq;
+  out[3] = laneSum(sMx) + tMx, out[4] = laneSum(sMg) + tMg;
 }
 
 HAMILTONE_TARGET void savDots(long n, const double* g, const double* q, const double* qm,
@@ -214,22 +271,40 @@ HAMILTONE_TARGET void savDots(long n, const double* g, const double* q, const do
   savDotsOf<false, false>(n, g, q, qm, minv, kq, x, xScale, out);
 }
 
+// (40) solved by (33) at one coordinate, or at a register of them (T: double or Lanes).
+template <bool stiff, bool extra, class T>
+HAMILTONE_TARGET inline T savNext(T qi, T qmi, T mi, T gi, T kqi, T xi, double xScale, double down,
+                                  double kk, double c, double invUp) {
+  T b = 2.0 * qi - down * qmi;
+  if constexpr (stiff) b -= kk * (mi * kqi);
+  if constexpr (extra) b -= mi * (xScale * xi);
+  return (b + c * (mi * gi)) * invUp;
+}
+
+// q^{n+1} element by element (the same bits on every path), its sum as savDotsOf's.
 template <bool stiff, bool extra>
 HAMILTONE_TARGET double savUpdateOf(long n, const double* g, const double* q, const double* qm,
                                     const double* minv, const double* kq, const double* x,
                                     double xScale, double down, double kk, double c, double invUp,
                                     double* qp) {
-  double sdq = 0.0;
-#pragma omp simd reduction(+ : sdq)
-  for (long i = 0; i < n; ++i) {
-    double b = 2.0 * q[i] - down * qm[i];
-    if constexpr (stiff) b -= kk * (minv[i] * kq[i]);
-    if constexpr (extra) b -= minv[i] * (xScale * x[i]);
-    const double next = (b + c * (minv[i] * g[i])) * invUp;  // not read back from qp
-    qp[i] = next;
-    sdq += g[i] * (next - qm[i]);
+  Lanes sdq = {};
+  long i = 0;
+  for (; i + kLanes <= n; i += kLanes) {
+    const Lanes gi = loadLanes(g + i), qmi = loadLanes(qm + i);
+    const Lanes x1 = savNext<stiff, extra>(
+        loadLanes(q + i), qmi, loadLanes(minv + i), gi, stiff ? loadLanes(kq + i) : Lanes{},
+        extra ? loadLanes(x + i) : Lanes{}, xScale, down, kk, c, invUp);
+    __builtin_memcpy(qp + i, &x1, sizeof x1);
+    sdq += gi * (x1 - qmi);
   }
-  return sdq;
+  double tail = 0.0;
+  for (; i < n; ++i) {
+    const double x1 = savNext<stiff, extra>(q[i], qm[i], minv[i], g[i], stiff ? kq[i] : 0.0,
+                                            extra ? x[i] : 0.0, xScale, down, kk, c, invUp);
+    qp[i] = x1;
+    tail += g[i] * (x1 - qm[i]);
+  }
+  return laneSum(sdq) + tail;
 }
 
 HAMILTONE_TARGET double savUpdate(long n, const double* g, const double* q, const double* qm,
@@ -264,26 +339,6 @@ HAMILTONE_TARGET void linearUpdate(long n, const double* q, const double* qm, co
   if (kq) return linearUpdateOf<true, false>(n, q, qm, minv, kq, x, xScale, down, kk, invUp, qp);
   if (x) return linearUpdateOf<false, true>(n, q, qm, minv, kq, x, xScale, down, kk, invUp, qp);
   linearUpdateOf<false, false>(n, q, qm, minv, kq, x, xScale, down, kk, invUp, qp);
-}
-
-// One vector register of doubles (GCC's vector extension, so that the loops below are vectorised
-// as written, whatever the compiler's cost model).
-typedef double Lanes __attribute__((vector_size(kLanes * sizeof(double))));
-
-// A register's lanes summed as a tree: halves, then quarters, … (the order of every call on a
-// path).
-HAMILTONE_TARGET inline double laneSum(Lanes s) {
-  double lane[kLanes];
-  __builtin_memcpy(lane, &s, sizeof s);
-  for (int width = kLanes / 2; width > 0; width /= 2)
-    for (int i = 0; i < width; ++i) lane[i] += lane[i + width];
-  return lane[0];
-}
-
-HAMILTONE_TARGET inline Lanes loadLanes(const double* p) {
-  Lanes x;
-  __builtin_memcpy(&x, p, sizeof x);
-  return x;
 }
 
 // Whole registers, their sums kept as lanes and added once at the end; then the modes past the
