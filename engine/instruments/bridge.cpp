@@ -44,8 +44,9 @@ void Bridge::prepare(const BridgePhysics& p, double k, double addedStiffness) {
               " kg at this rate, or the explicit coupling is unstable");
   physics_ = p;
   k_ = k;
-  up_ = 1.0 + p.resistance * k / (2.0 * p.mass);
+  invUp_ = 1.0 / (1.0 + p.resistance * k / (2.0 * p.mass));
   down_ = 1.0 - p.resistance * k / (2.0 * p.mass);
+  rate_ = 1.0 / k;
   kkOverM_ = k * k / p.mass;
   reset();
 }
@@ -57,8 +58,8 @@ void Bridge::reset() noexcept {
 
 double Bridge::advance(double& before, double& now, double force) noexcept {
   const double next =
-      (2.0 * now - down_ * before + kkOverM_ * (force - physics_.stiffness * now)) / up_;
-  const double velocity = (next - before) / (2.0 * k_);  // δt· w
+      (2.0 * now - down_ * before + kkOverM_ * (force - physics_.stiffness * now)) * invUp_;
+  const double velocity = 0.5 * (next - before) * rate_;  // δt· w
   dissipated_ += physics_.resistance * k_ * velocity * velocity;
   before = now;
   now = next;
@@ -83,7 +84,7 @@ double Bridge::energy() const { return partEnergy(w0_, w1_) + partEnergy(d0_, d1
 
 double Bridge::forceOnBoard() const {
   const double w = w1_ + d1_, before = w0_ + d0_;
-  return physics_.stiffness * w + physics_.resistance * (w - before) / k_;
+  return physics_.stiffness * w + physics_.resistance * (w - before) * rate_;
 }
 
 }  // namespace hamiltone

@@ -124,7 +124,9 @@ class Bridge {
 
  private:
   BridgePhysics physics_;
-  double k_ = 0.0, up_ = 1.0, down_ = 1.0, kkOverM_ = 0.0;
+  // k, 1/(1 + Rk/2M), 1 − Rk/2M, k²/M, 1/k: the step's constants, the divisions taken once (the
+  // step is on every sample's chain of latencies from the strings back to them).
+  double k_ = 0.0, invUp_ = 1.0, down_ = 1.0, kkOverM_ = 0.0, rate_ = 0.0;
   double w0_ = 0.0, w1_ = 0.0;  // w_F^n, w_F^{n+1}
   double d0_ = 0.0, d1_ = 0.0;  // w_D^n, w_D^{n+1}
   // One step of either part under its force, its losses added to dissipated_.

@@ -348,6 +348,7 @@ void StringVoice::prepare(const StringPatch& patch, int midiNote, double sampleR
   patch_ = patch;
   sampleRate_ = sampleRate;
   k_ = k;
+  rate_ = 1.0 / k;
   feltNode_ = felt.nodes;
   feltNodes_ = hasFelt ? felt.count : 0;
   feltR_ = felt.resistance;
@@ -566,7 +567,7 @@ double StringVoice::pickup(const Vector& q, const Vector& qNext, const PickupTap
     return tap.weight * x[tap.node] + tap.nextWeight * x[tap.next];
   };
   if (patch_.signal == PickupSignal::displacement) return at(q);
-  return (at(qNext) - at(q)) / k_;
+  return (at(qNext) - at(q)) * rate_;
 }
 
 // The linear tail. The tension modulation, ΔT = (EA/2) Z̄ with Z̄ = (1/L) ∫ u_x² the mean square
@@ -709,8 +710,9 @@ bool StringVoice::stepAndPick(double out[2]) noexcept {
     double value;
     if (inModes_) {
       const auto p = static_cast<ModalTail::Probe>(ModalTail::kPickup0 + c);
-      value = patch_.signal == PickupSignal::displacement ? modal_.at(p)
-                                                          : (modal_.atNext(p) - modal_.at(p)) / k_;
+      value = patch_.signal == PickupSignal::displacement
+                  ? modal_.at(p)
+                  : (modal_.atNext(p) - modal_.at(p)) * rate_;
     } else {
       value = pickup(scheme_->q(), scheme_->qNext(), taps_[c]);
     }

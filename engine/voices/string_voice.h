@@ -241,6 +241,7 @@ class StringVoice {
   int feltNodes_ = 0;
   double feltR_ = 0.0;
   double sampleRate_ = 0.0, k_ = 0.0, fundamental_ = 0.0;
+  double rate_ = 0.0;  // 1/k: the pickups' velocity, a product on every step, not a division
   double bend_ = 0.0, bendSlope_ = 0.0, bendOffset_ = 0.0;  // λ1(β) = bendSlope_·β + bendOffset_
   double injected_ = 0.0, caught_ = 0.0;
   int guardEvents_ = 0;
