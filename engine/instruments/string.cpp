@@ -313,9 +313,10 @@ double NonlinearString::singleGridGradient(const Vector& q, Vector& grad) const 
   double* vp = scratch_.data();
   padded(q.data(), m, up);
   padded(q.data() + (m - 1), m, vp);
-  const double sum = kernels_->singleGridForces(up, vp, m, 1.0 / h_, c, work1_.data(),
-                                                work2_.data(), grad.data(), grad.data() + (m - 1));
-  endTension_ = (physics_.tension * (vp[m] - vp[m - 1]) + work2_[m - 1]) / h_;
+  const double invH = 1.0 / h_;
+  const double sum = kernels_->singleGridForces(up, vp, m, invH, c, work1_.data(), work2_.data(),
+                                                grad.data(), grad.data() + (m - 1));
+  endTension_ = (physics_.tension * (vp[m] - vp[m - 1]) + work2_[m - 1]) * invH;  // bridge's chain
   return 0.5 * c * sum;
 }
 
@@ -335,7 +336,7 @@ void NonlinearString::cellStrains(const Vector& q, double* strain, double* inver
 NonlinearString::OneCell NonlinearString::oneCell(const Vector& q) const {
   const Eigen::Index m = segments_;
   const double* u = q.data();
-  const double invH = 1.0 / h_;
+  const double invH = 1.0 / h_, invM = 1.0 / static_cast<double>(m);  // off the chain below
   const double first = u[0] * invH, last = u[m - 2] * invH;
   double sum = first * first + last * last;
 #pragma omp simd reduction(+ : sum)
@@ -343,9 +344,10 @@ NonlinearString::OneCell NonlinearString::oneCell(const Vector& q) const {
     const double zeta = (u[l] - u[l - 1]) * invH;
     sum += zeta * zeta;
   }
-  const double mean = sum / static_cast<double>(m);
+  const double mean = sum * invM;
   const double stretch = std::sqrt(1.0 + mean);
-  return {mean / (stretch + 1.0), stretch};  // ε = S − 1 without cancellation
+  // ε = S − 1 without cancellation, and ε/S: one division each after the root, side by side.
+  return {mean / (stretch + 1.0), mean / ((stretch + 1.0) * stretch)};
 }
 
 // Its gradient, the two grids' with r = M and η = 0: ∂V'/∂ζ_l = c (ε/S) ζ_l, so
@@ -355,10 +357,13 @@ double NonlinearString::oneCellGradient(const Vector& q, Vector& grad) const {
   const Eigen::Index m = segments_;
   const double* u = q.data();
   double* gu = grad.data();
-  const OneCell cell = oneCell(q);
+  // The constants' divisions first: the step waits on the chain from u through the cell's root to
+  // the gradient, and a division by a constant on it would lengthen it.
   const double c = (physics_.young * physics_.area - physics_.tension) * h_;
-  const double weight = c * cell.strain / cell.stretch;
-  const double f = weight / (h_ * h_);
+  const double perH2 = 1.0 / (h_ * h_), perHv = static_cast<double>(m) / hv_;
+  const OneCell cell = oneCell(q);
+  const double weight = c * cell.strainOverStretch;
+  const double f = weight * perH2;
   if (m == 2) {
     gu[0] = 2.0 * f * u[0];
   } else {
@@ -367,7 +372,7 @@ double NonlinearString::oneCellGradient(const Vector& q, Vector& grad) const {
 #pragma omp simd
     for (Eigen::Index j = 1; j < m - 2; ++j) gu[j] = f * (2.0 * u[j] - u[j - 1] - u[j + 1]);
   }
-  endTension_ = weight * static_cast<double>(m) / hv_;
+  endTension_ = weight * perHv;
   return cellsPotential(cell.strain * cell.strain);
 }
 

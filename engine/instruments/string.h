@@ -126,7 +126,8 @@ class NonlinearString {
   double linearEndTension(const Vector& q) const;
   // The same from v_{Mv−1}, the last node of v.
   double linearEndTension(double lastV) const {
-    return grid_.longitudinal < 2 ? 0.0 : physics_.young * physics_.area * (-lastV / hv_);
+    // The bridge's chain of latencies runs through it each step: a product, not a division.
+    return grid_.longitudinal < 2 ? 0.0 : -lastV * (physics_.young * physics_.area / hv_);
   }
 
   // Eigenvalue m = 1 … M−1 of M⁻¹K on u: (βT0/ρA)(4/h²) s² + (EI/ρA)(16/h⁴) s⁴, s = sin(mπ/2M).
@@ -147,7 +148,7 @@ class NonlinearString {
   double cellsPotential(double squaredStrains) const;  // V' of the two grids from Σ_J ε_J²
   double twoGridGradient(const Vector& q, Vector& grad) const;
   struct OneCell {
-    double strain, stretch;  // ε = S − 1 and S of the string's one coarse cell
+    double strain, strainOverStretch;  // ε = S − 1 and ε/S of the string's one coarse cell
   };
   OneCell oneCell(const Vector& q) const;
   double oneCellGradient(const Vector& q, Vector& grad) const;
