@@ -217,44 +217,50 @@ TEST(Kernels, PlateProductsAndStencilsAreBitIdenticalOnEveryPath) {
   }
 }
 
+// The SAV's passes on every path, the portable one too, over lengths shorter than a register, whole
+// registers and registers with a tail: q^{n+1} element by element the bits of the formula written
+// out (and the linear step's, with no gradient); the sums, whose order is each path's (registers,
+// then the tail, then the lanes as a tree), within their reordering bound of the sum in order.
 TEST(Kernels, SchemeSumsAgreeWithinTheirReorderingBound) {
-  const Kernels& base = kernelsFor(Isa::portable);
-  const long n = 387;
-  const std::vector<double> g = randomArray(n, 1.0, 3), q = randomArray(n, 1e-3, 4),
-                            qm = randomArray(n, 1e-3, 5), minv = randomArray(n, 10.0, 6),
-                            kq = randomArray(n, 1e2, 7), x = randomArray(n, 1e-2, 8);
-  double bound[5] = {};
-  for (long i = 0; i < n; ++i) {
-    bound[0] += std::abs(g[i] * q[i]);
-    bound[1] += std::abs(g[i] * qm[i]);
-    bound[2] += std::abs(g[i] * minv[i] * kq[i]);
-    bound[3] += std::abs(g[i] * minv[i] * x[i]);
-    bound[4] += std::abs(g[i] * minv[i] * g[i]);
-  }
-  const std::vector<const Kernels*> paths = otherPaths();
-  if (paths.empty()) GTEST_SKIP() << "this CPU runs only the portable kernels";
-  for (const Kernels* path : paths) {
-    double d1[5], d2[5];
-    base.savDots(n, g.data(), q.data(), qm.data(), minv.data(), kq.data(), x.data(), 1.0, d1);
-    path->savDots(n, g.data(), q.data(), qm.data(), minv.data(), kq.data(), x.data(), 1.0, d2);
-    for (int j = 0; j < 5; ++j) EXPECT_NEAR(d1[j], d2[j], n * 1.2e-16 * bound[j]) << path->name;
-    std::vector<double> p1(n), p2(n);
-    const double s1 = base.savUpdate(n, g.data(), q.data(), qm.data(), minv.data(), kq.data(),
-                                     nullptr, 1.0, 0.99, 1e-9, 0.3, 1.0 / 1.01, p1.data());
-    const double s2 = path->savUpdate(n, g.data(), q.data(), qm.data(), minv.data(), kq.data(),
-                                      nullptr, 1.0, 0.99, 1e-9, 0.3, 1.0 / 1.01, p2.data());
-    EXPECT_EQ(p1, p2) << path->name;  // element by element: no reordering
-    double sum = 0.0;
-    for (long i = 0; i < n; ++i) sum += std::abs(g[i] * (p1[i] - qm[i]));
-    EXPECT_NEAR(s1, s2, n * 1.2e-16 * sum) << path->name;
-    // The linear step is the same update with no gradient: element by element, the bits of
-    // savUpdate's with c = 0 on every path, the loss term too.
-    for (const double* loss : {static_cast<const double*>(nullptr), x.data()}) {
-      base.savUpdate(n, g.data(), q.data(), qm.data(), minv.data(), kq.data(), loss, 0.7, 0.99,
-                     1e-9, 0.0, 1.0 / 1.01, p1.data());
-      path->linearUpdate(n, q.data(), qm.data(), minv.data(), kq.data(), loss, 0.7, 0.99, 1e-9,
-                         1.0 / 1.01, p2.data());
-      EXPECT_EQ(p1, p2) << path->name;
+  std::vector<const Kernels*> paths = otherPaths();
+  paths.push_back(&kernelsFor(Isa::portable));
+  const double down = 0.99, kk = 1e-9, c = 0.3, invUp = 1.0 / 1.01;
+  for (long n : {1L, 3L, 8L, 13L, 35L, 387L}) {
+    const std::vector<double> g = randomArray(n, 1.0, 3), q = randomArray(n, 1e-3, 4),
+                              qm = randomArray(n, 1e-3, 5), minv = randomArray(n, 10.0, 6),
+                              kq = randomArray(n, 1e2, 7), x = randomArray(n, 1e-2, 8);
+    double sums[5] = {}, bound[5] = {};
+    std::vector<double> next(n);
+    double sdq = 0.0, sdqBound = 0.0;
+    for (long i = 0; i < n; ++i) {
+      const double terms[5] = {g[i] * q[i], g[i] * qm[i], g[i] * (minv[i] * kq[i]),
+                               g[i] * (minv[i] * (0.5 * x[i])), g[i] * minv[i] * g[i]};
+      for (int j = 0; j < 5; ++j) sums[j] += terms[j], bound[j] += std::abs(terms[j]);
+      double b = 2.0 * q[i] - down * qm[i];
+      b -= kk * (minv[i] * kq[i]);
+      next[i] = (b + c * (minv[i] * g[i])) * invUp;
+      sdq += g[i] * (next[i] - qm[i]);
+      sdqBound += std::abs(g[i] * (next[i] - qm[i]));
+    }
+    for (const Kernels* path : paths) {
+      double d[5];
+      path->savDots(n, g.data(), q.data(), qm.data(), minv.data(), kq.data(), x.data(), 0.5, d);
+      for (int j = 0; j < 5; ++j)
+        EXPECT_NEAR(d[j], sums[j], n * 1.2e-16 * bound[j]) << path->name << " n = " << n;
+      std::vector<double> p(n), linear(n);
+      const double s = path->savUpdate(n, g.data(), q.data(), qm.data(), minv.data(), kq.data(),
+                                       nullptr, 1.0, down, kk, c, invUp, p.data());
+      EXPECT_EQ(p, next) << path->name << " n = " << n;  // element by element: no reordering
+      EXPECT_NEAR(s, sdq, n * 1.2e-16 * sdqBound) << path->name << " n = " << n;
+      // The linear step is the same update with no gradient: element by element, the bits of
+      // savUpdate's with c = 0 on every path, the loss term too.
+      for (const double* loss : {static_cast<const double*>(nullptr), x.data()}) {
+        path->savUpdate(n, g.data(), q.data(), qm.data(), minv.data(), kq.data(), loss, 0.7, down,
+                        kk, 0.0, invUp, p.data());
+        path->linearUpdate(n, q.data(), qm.data(), minv.data(), kq.data(), loss, 0.7, down, kk,
+                           invUp, linear.data());
+        EXPECT_EQ(p, linear) << path->name << " n = " << n;
+      }
     }
   }
 }
