@@ -126,7 +126,8 @@ class NonlinearString {
   double linearEndTension(const Vector& q) const;
   // The same from v_{Mv−1}, the last node of v.
   double linearEndTension(double lastV) const {
-    // The bridge's chain of latencies runs through it each step: a product, not a division.
+    // The bridge's chain of latencies runs through v each step: v's part is a product; EA / h_v
+    // depends on constants alone, so it does not wait on v.
     return grid_.longitudinal < 2 ? 0.0 : -lastV * (physics_.young * physics_.area / hv_);
   }
 

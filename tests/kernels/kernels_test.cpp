@@ -13,6 +13,7 @@
 #include <numbers>
 #include <random>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "instruments/hammer.h"
@@ -74,18 +75,48 @@ TEST(Kernels, StencilsAndForcesAreBitIdenticalOnEveryPath) {
       base.secondDifferenceOfDifference(a.data(), b.data(), x.data(), n, 2.1);
       path->secondDifferenceOfDifference(a.data(), b.data(), y.data(), n, 2.1);
       EXPECT_EQ(x, y) << path->name << " n = " << n;
-      // One grid: u and v padded, m = n + 1 segments; the forces bit for bit, the sum reordered.
-      const std::vector<double> upS = randomArray(n + 2, 1e-3, 12),
-                                vp = randomArray(n + 2, 1e-4, 11);
-      std::vector<double> wz1(n + 1), we1(n + 1), gu1(n), gv1(n), wz2(n + 1), we2(n + 1), gu2(n),
-          gv2(n);
-      const double sum1 = base.singleGridForces(upS.data(), vp.data(), n + 1, 100.0, 5.0,
-                                                wz1.data(), we1.data(), gu1.data(), gv1.data());
-      const double sum2 = path->singleGridForces(upS.data(), vp.data(), n + 1, 100.0, 5.0,
-                                                 wz2.data(), we2.data(), gu2.data(), gv2.data());
-      EXPECT_EQ(gu1, gu2) << path->name;
-      EXPECT_EQ(gv1, gv2) << path->name;
-      EXPECT_NEAR(sum1, sum2, (n + 1) * 1.2e-16 * sum1) << path->name;  // all terms >= 0
+    }
+  }
+}
+
+// A sum of n terms taken in two orders (registers, a tail, lanes as a tree, against one by one)
+// differs by at most about 2 n u Σ|terms|, u = 2⁻⁵³ (each partial sum of either rounds once).
+double reorderingBound(long n, double absoluteSum) { return 2.0 * n * 1.12e-16 * absoluteSum; }
+
+// The single grid's forces on every path, the portable one too: u and v padded, m = n + 1
+// segments; the weights and the forces the bits of the formulas written out, the sum of the squared
+// excesses within its reordering bound.
+TEST(Kernels, SingleGridForcesAreTheFormulasOnEveryPath) {
+  std::vector<const Kernels*> paths = otherPaths();
+  paths.push_back(&kernelsFor(Isa::portable));
+  const double invH = 100.0, c = 5.0;
+  for (long n : {1L, 2L, 7L, 8L, 15L, 64L, 343L}) {
+    const long m = n + 1;
+    const std::vector<double> up = randomArray(m + 1, 1e-3, 12), vp = randomArray(m + 1, 1e-4, 11);
+    std::vector<double> wz(m), we(m), gu(n), gv(n);
+    double sum = 0.0;
+    for (long l = 0; l < m; ++l) {
+      const double zeta = (up[l + 1] - up[l]) * invH, eta = (vp[l + 1] - vp[l]) * invH;
+      const double stretch = std::sqrt((1.0 + eta) * (1.0 + eta) + zeta * zeta);
+      const double excess = (2.0 * eta + eta * eta + zeta * zeta) / (stretch + 1.0);
+      const double phi = excess / stretch;
+      wz[l] = c * phi * zeta;
+      we[l] = c * phi * (1.0 + eta);
+      sum += excess * excess;
+    }
+    for (long j = 0; j < n; ++j) {
+      gu[j] = (wz[j] - wz[j + 1]) * invH;
+      gv[j] = (we[j] - we[j + 1]) * invH;
+    }
+    for (const Kernels* path : paths) {
+      std::vector<double> wz1(m), we1(m), gu1(n), gv1(n);
+      const double sum1 = path->singleGridForces(up.data(), vp.data(), m, invH, c, wz1.data(),
+                                                 we1.data(), gu1.data(), gv1.data());
+      EXPECT_EQ(wz1, wz) << path->name << " n = " << n;
+      EXPECT_EQ(we1, we) << path->name << " n = " << n;
+      EXPECT_EQ(gu1, gu) << path->name << " n = " << n;
+      EXPECT_EQ(gv1, gv) << path->name << " n = " << n;
+      EXPECT_NEAR(sum1, sum, reorderingBound(m, sum)) << path->name << " n = " << n;  // terms >= 0
     }
   }
 }
@@ -217,51 +248,71 @@ TEST(Kernels, PlateProductsAndStencilsAreBitIdenticalOnEveryPath) {
   }
 }
 
-// The SAV's passes on every path, the portable one too, over lengths shorter than a register, whole
-// registers and registers with a tail: q^{n+1} element by element the bits of the formula written
-// out (and the linear step's, with no gradient); the sums, whose order is each path's (registers,
-// then the tail, then the lanes as a tree), within their reordering bound of the sum in order.
+// The SAV's passes on every path, the portable one too, with and without K q and the loss's term,
+// over lengths shorter than a register, whole registers and registers with a tail: q^{n+1} element
+// by element the bits of the formula written out (and the linear step's, with no gradient); the
+// sums, whose order is each path's (registers, then the tail, then the lanes as a tree), within
+// their reordering bound of the sum in order. The inputs sit between NaNs, which a read past
+// either end would carry into the results, and q^{n+1} before a sentinel.
 TEST(Kernels, SchemeSumsAgreeWithinTheirReorderingBound) {
   std::vector<const Kernels*> paths = otherPaths();
   paths.push_back(&kernelsFor(Isa::portable));
-  const double down = 0.99, kk = 1e-9, c = 0.3, invUp = 1.0 / 1.01;
+  const double down = 0.99, kk = 1e-9, c = 0.3, invUp = 1.0 / 1.01, xScale = 0.5;
+  auto fenced = [](const std::vector<double>& a) {
+    std::vector<double> f(kMaxLanes, NAN);
+    f.insert(f.end(), a.begin(), a.end());
+    f.resize(f.size() + kMaxLanes, NAN);
+    return f;
+  };
   for (long n : {1L, 3L, 8L, 13L, 35L, 387L}) {
     const std::vector<double> g = randomArray(n, 1.0, 3), q = randomArray(n, 1e-3, 4),
                               qm = randomArray(n, 1e-3, 5), minv = randomArray(n, 10.0, 6),
                               kq = randomArray(n, 1e2, 7), x = randomArray(n, 1e-2, 8);
-    double sums[5] = {}, bound[5] = {};
-    std::vector<double> next(n);
-    double sdq = 0.0, sdqBound = 0.0;
-    for (long i = 0; i < n; ++i) {
-      const double terms[5] = {g[i] * q[i], g[i] * qm[i], g[i] * (minv[i] * kq[i]),
-                               g[i] * (minv[i] * (0.5 * x[i])), g[i] * minv[i] * g[i]};
-      for (int j = 0; j < 5; ++j) sums[j] += terms[j], bound[j] += std::abs(terms[j]);
-      double b = 2.0 * q[i] - down * qm[i];
-      b -= kk * (minv[i] * kq[i]);
-      next[i] = (b + c * (minv[i] * g[i])) * invUp;
-      sdq += g[i] * (next[i] - qm[i]);
-      sdqBound += std::abs(g[i] * (next[i] - qm[i]));
-    }
-    for (const Kernels* path : paths) {
-      double d[5];
-      path->savDots(n, g.data(), q.data(), qm.data(), minv.data(), kq.data(), x.data(), 0.5, d);
-      for (int j = 0; j < 5; ++j)
-        EXPECT_NEAR(d[j], sums[j], n * 1.2e-16 * bound[j]) << path->name << " n = " << n;
-      std::vector<double> p(n), linear(n);
-      const double s = path->savUpdate(n, g.data(), q.data(), qm.data(), minv.data(), kq.data(),
-                                       nullptr, 1.0, down, kk, c, invUp, p.data());
-      EXPECT_EQ(p, next) << path->name << " n = " << n;  // element by element: no reordering
-      EXPECT_NEAR(s, sdq, n * 1.2e-16 * sdqBound) << path->name << " n = " << n;
-      // The linear step is the same update with no gradient: element by element, the bits of
-      // savUpdate's with c = 0 on every path, the loss term too.
-      for (const double* loss : {static_cast<const double*>(nullptr), x.data()}) {
-        path->savUpdate(n, g.data(), q.data(), qm.data(), minv.data(), kq.data(), loss, 0.7, down,
-                        kk, 0.0, invUp, p.data());
-        path->linearUpdate(n, q.data(), qm.data(), minv.data(), kq.data(), loss, 0.7, down, kk,
-                           invUp, linear.data());
-        EXPECT_EQ(p, linear) << path->name << " n = " << n;
+    const std::vector<double> gF = fenced(g), qF = fenced(q), qmF = fenced(qm),
+                              minvF = fenced(minv), kqF = fenced(kq), xF = fenced(x);
+    const double* in[6] = {gF.data() + kMaxLanes,    qF.data() + kMaxLanes,  qmF.data() + kMaxLanes,
+                           minvF.data() + kMaxLanes, kqF.data() + kMaxLanes, xF.data() + kMaxLanes};
+    for (bool stiff : {false, true})
+      for (bool extra : {false, true}) {
+        const double* kqIn = stiff ? in[4] : nullptr;
+        const double* xIn = extra ? in[5] : nullptr;
+        double sums[5] = {}, bound[5] = {};
+        std::vector<double> next(n);
+        double sdq = 0.0, sdqBound = 0.0;
+        for (long i = 0; i < n; ++i) {
+          const double terms[5] = {
+              g[i] * q[i], g[i] * qm[i], stiff ? g[i] * (minv[i] * kq[i]) : 0.0,
+              extra ? g[i] * (minv[i] * (xScale * x[i])) : 0.0, g[i] * minv[i] * g[i]};
+          for (int j = 0; j < 5; ++j) sums[j] += terms[j], bound[j] += std::abs(terms[j]);
+          double b = 2.0 * q[i] - down * qm[i];
+          if (stiff) b -= kk * (minv[i] * kq[i]);
+          if (extra) b -= minv[i] * (xScale * x[i]);
+          next[i] = (b + c * (minv[i] * g[i])) * invUp;
+          sdq += g[i] * (next[i] - qm[i]);
+          sdqBound += std::abs(g[i] * (next[i] - qm[i]));
+        }
+        for (const Kernels* path : paths) {
+          const std::string what = std::string(path->name) + " n = " + std::to_string(n) +
+                                   (stiff ? " K q" : "") + (extra ? " loss" : "");
+          double d[5];
+          path->savDots(n, in[0], in[1], in[2], in[3], kqIn, xIn, xScale, d);
+          for (int j = 0; j < 5; ++j)
+            EXPECT_NEAR(d[j], sums[j], reorderingBound(n, bound[j])) << what;
+          std::vector<double> p(n + 1, -1.0), linear(n + 1, -1.0);
+          const double s = path->savUpdate(n, in[0], in[1], in[2], in[3], kqIn, xIn, xScale, down,
+                                           kk, c, invUp, p.data());
+          EXPECT_EQ(std::vector<double>(p.begin(), p.begin() + n), next) << what;
+          EXPECT_EQ(p[n], -1.0) << what << ": wrote past q^{n+1}";
+          EXPECT_NEAR(s, sdq, reorderingBound(n, sdqBound)) << what;
+          // The linear step is the same update with no gradient: element by element, the bits
+          // of savUpdate's with c = 0 on every path.
+          path->savUpdate(n, in[0], in[1], in[2], in[3], kqIn, xIn, xScale, down, kk, 0.0, invUp,
+                          p.data());
+          path->linearUpdate(n, in[1], in[2], in[3], kqIn, xIn, xScale, down, kk, invUp,
+                             linear.data());
+          EXPECT_EQ(p, linear) << what;
+        }
       }
-    }
   }
 }
 
