@@ -128,20 +128,21 @@ HAMILTONE_TARGET TwoGridSums twoGridForces(const double* u, const double* v, lon
   return {sum, tension * eta[mv - 1] + strain[mv - 1] * invHv};
 }
 
+HAMILTONE_TARGET inline double squareRoot(double x) { return __builtin_sqrt(x); }
+HAMILTONE_TARGET inline Lanes squareRoot(Lanes x) {
+  for (int i = 0; i < kLanes; ++i) x[i] = __builtin_sqrt(x[i]);
+  return x;
+}
+
 // One segment's weights (T: double or Lanes), its excess S − 1 returned.
 template <class T>
-HAMILTONE_TARGET inline T segmentWeights(T zeta, T eta, T sqrtStretch(T), double c, T& wz, T& we) {
-  const T stretch = sqrtStretch((1.0 + eta) * (1.0 + eta) + zeta * zeta);
+HAMILTONE_TARGET inline T segmentWeights(T zeta, T eta, double c, T& wz, T& we) {
+  const T stretch = squareRoot((1.0 + eta) * (1.0 + eta) + zeta * zeta);
   const T excess = (2.0 * eta + eta * eta + zeta * zeta) / (stretch + 1.0);
   const T phi = excess / stretch;
   wz = c * phi * zeta;
   we = c * phi * (1.0 + eta);
   return excess;
-}
-HAMILTONE_TARGET inline double scalarSqrt(double x) { return __builtin_sqrt(x); }
-HAMILTONE_TARGET inline Lanes lanesSqrt(Lanes x) {
-  for (int i = 0; i < kLanes; ++i) x[i] = __builtin_sqrt(x[i]);
-  return x;
 }
 
 // Whole registers, the sum kept as lanes (savDotsOf's reason), then the last segments one by one.
@@ -151,17 +152,17 @@ HAMILTONE_TARGET double singleGridForces(const double* up, const double* vp, lon
   long l = 0;
   for (; l + kLanes <= m; l += kLanes) {
     Lanes z, e;
-    const Lanes excess = segmentWeights<Lanes>((loadLanes(up + l + 1) - loadLanes(up + l)) * invH,
-                                               (loadLanes(vp + l + 1) - loadLanes(vp + l)) * invH,
-                                               lanesSqrt, c, z, e);
+    const Lanes excess =
+        segmentWeights<Lanes>((loadLanes(up + l + 1) - loadLanes(up + l)) * invH,
+                              (loadLanes(vp + l + 1) - loadLanes(vp + l)) * invH, c, z, e);
     __builtin_memcpy(wz + l, &z, sizeof z);
     __builtin_memcpy(we + l, &e, sizeof e);
     sums += excess * excess;
   }
   double sum = 0.0;
   for (; l < m; ++l) {
-    const double excess = segmentWeights<double>(
-        (up[l + 1] - up[l]) * invH, (vp[l + 1] - vp[l]) * invH, scalarSqrt, c, wz[l], we[l]);
+    const double excess = segmentWeights<double>((up[l + 1] - up[l]) * invH,
+                                                 (vp[l + 1] - vp[l]) * invH, c, wz[l], we[l]);
     sum += excess * excess;
   }
   sum += laneSum(sums);

@@ -173,7 +173,7 @@ void UnisonStrings::processBridged(std::span<float> left, std::span<float> right
     }
     left[i] = static_cast<float>(sum[0]);
     right[i] = static_cast<float>(stereo ? sum[1] : sum[0]);
-    boardForce_[i] = static_cast<float>(steps == 1 ? force : force / steps);
+    boardForce_[i] = static_cast<float>(force / steps);
     // The guard: a non-finite sample never leaves the key, nor does runaway energy, looked at
     // every kGuardEvery samples of the key's own. The samples as they leave, in float: a finite
     // sum beyond float's range (a gain too large) would leave as an infinity.

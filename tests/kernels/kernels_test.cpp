@@ -38,6 +38,15 @@ std::vector<double> randomArray(long n, double scale, unsigned seed) {
   return a;
 }
 
+// a between kMaxLanes NaNs on each side (its values start at kMaxLanes): a kernel that reads past
+// either end of a carries a NaN into its results.
+std::vector<double> fenced(const std::vector<double>& a) {
+  std::vector<double> f(kMaxLanes, NAN);
+  f.insert(f.end(), a.begin(), a.end());
+  f.resize(f.size() + kMaxLanes, NAN);
+  return f;
+}
+
 TEST(Kernels, StencilsAndForcesAreBitIdenticalOnEveryPath) {
   const Kernels& base = kernelsFor(Isa::portable);
   const std::vector<const Kernels*> paths = otherPaths();
@@ -162,10 +171,8 @@ TEST(Kernels, TwoGridStrainsAndForcesAreTheFormulasOnEveryPath) {
       }
       for (long j = 0; j + 1 < mv; ++j) gv[j] = (we[j] - we[j + 1]) * invHv;
       const double end = tension * eta[mv - 1] + we[mv - 1] * invHv;
-      std::vector<double> fenced(kMaxLanes, NAN);
-      fenced.insert(fenced.end(), u.begin(), u.end());
-      fenced.resize(fenced.size() + kMaxLanes, NAN);
-      const double* inPlace = fenced.data() + kMaxLanes;
+      const std::vector<double> uFenced = fenced(u);
+      const double* inPlace = uFenced.data() + kMaxLanes;
       for (const Kernels* k : paths) {
         std::vector<double> s(mv), i(mv), strainsWork(twoGridStrainsWork(m, mv), NAN);
         k->cellStretches(inPlace, v.data(), mv, r, invH, invHv, strainsWork.data(), s.data(),
@@ -258,12 +265,6 @@ TEST(Kernels, SchemeSumsAgreeWithinTheirReorderingBound) {
   std::vector<const Kernels*> paths = otherPaths();
   paths.push_back(&kernelsFor(Isa::portable));
   const double down = 0.99, kk = 1e-9, c = 0.3, invUp = 1.0 / 1.01, xScale = 0.5;
-  auto fenced = [](const std::vector<double>& a) {
-    std::vector<double> f(kMaxLanes, NAN);
-    f.insert(f.end(), a.begin(), a.end());
-    f.resize(f.size() + kMaxLanes, NAN);
-    return f;
-  };
   for (long n : {1L, 3L, 8L, 13L, 35L, 387L}) {
     const std::vector<double> g = randomArray(n, 1.0, 3), q = randomArray(n, 1e-3, 4),
                               qm = randomArray(n, 1e-3, 5), minv = randomArray(n, 10.0, 6),
