@@ -43,6 +43,7 @@ void ModalTail::prepare(const NonlinearString& string, double k,
                         Eigen::Index second) {
   const double rhoA = string.physics().linearDensity();
   k_ = k;
+  endStiffness_ = string.physics().young * string.physics().area / string.longitudinalSpacing();
   u_.prepare(string.segments(), string.spacing(), rhoA);
   v_.prepare(string.grid().longitudinal, string.longitudinalSpacing(), rhoA);
   for (int p = 0; p < kProbes; ++p) {

@@ -69,8 +69,9 @@ class ModalTail {
   // A probe at level n and at level n + 1.
   double at(Probe p) const { return now_[p]; }
   double atNext(Probe p) const { return next_[p]; }
-  // v at its last node (v_{Mv−1}) at level n; 0 with one coarse cell.
-  double lastLongitudinal() const { return vLast_; }
+  // ΔT at the bridge's end at level n, EA η_M = −EA v_{Mv−1} / h_v
+  // (NonlinearString::linearEndTension); 0 with one coarse cell.
+  double endTension() const { return v_.modes == 0 ? 0.0 : -vLast_ * endStiffness_; }
 
   // H^{n+½} of the kept modes: the scheme's energy() of the linear string (kinetic with its σ1
   // correction, ½ q^{n+1}ᵀ K q^n), J.
@@ -122,7 +123,8 @@ class ModalTail {
   const Kernels* kernels_ = &selectedKernels();
   Grid u_, v_;
   double k_ = 0.0, sigma1_ = 0.0;
-  double forceScale_ = 0.0;  // k² / (ρA h (1 + σ0k)): a force's share of a mode's step
+  double forceScale_ = 0.0;    // k² / (ρA h (1 + σ0k)): a force's share of a mode's step
+  double endStiffness_ = 0.0;  // EA / h_v, taken once: the bridge's chain runs through v
   // The probes' modal weights (to registers(u's modes)), the pull's nodes', and v's last node's
   // (to registers(v's modes)).
   std::array<std::vector<double>, kProbes> weights_;

@@ -22,7 +22,6 @@ constexpr double kStrikeGap = 1e-4;            // m: the hammer starts 0.1 mm be
 constexpr double kParkedAt = -0.02;            // m: where the back-check holds it
 constexpr double kCheckDelay = 1e-3;           // s out of contact, moving away, before the catch
 constexpr double kCheckGap = 1e-3;             // m below the string, at least, when caught
-constexpr long kLinearCheckSteps = 256;        // the linear tail's check, every this many steps
 
 void require(bool ok, const char* field, double value, const std::string& valid) {
   if (!ok)
@@ -493,7 +492,7 @@ void StringVoice::wake() noexcept {
   active_ = true;
 }
 
-bool StringVoice::stepOnBridge(double w, double out[2]) noexcept {
+bool StringVoice::stepOnBridgeAndScheme(double w, double out[2]) noexcept {
   if (residualLeft_ != 0.0) {  // modes left since the last step (leaveModes)
     injected_ += 0.5 * residualLeft_ * bridgeAt_ * w;
     residualLeft_ = 0.0;
@@ -707,15 +706,8 @@ bool StringVoice::stepAndPick(double out[2]) noexcept {
   }
   bool ready = false;
   for (int c = 0; c < patch_.channels; ++c) {
-    double value;
-    if (inModes_) {
-      const auto p = static_cast<ModalTail::Probe>(ModalTail::kPickup0 + c);
-      value = patch_.signal == PickupSignal::displacement
-                  ? modal_.at(p)
-                  : (modal_.atNext(p) - modal_.at(p)) * rate_;
-    } else {
-      value = pickup(scheme_->q(), scheme_->qNext(), taps_[c]);
-    }
+    const double value =
+        inModes_ ? modalPickup(c) : pickup(scheme_->q(), scheme_->qNext(), taps_[c]);
     ready = decimators_[c].push(value, out[c]);
   }
   // After the pickups: the check changes what steps next, not this step's output.

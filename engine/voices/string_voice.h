@@ -69,6 +69,8 @@ constexpr double kMaxLinearBelow = 1e-3;
 // The modal tail's floor: the highest modes of a linear string are dropped while together they hold
 // under this share of its energy (−100 dB), checked every kLinearCheckSteps steps.
 constexpr double kModalFloor = 1e-10;
+// The linear tail's check, every this many steps.
+constexpr long kLinearCheckSteps = 256;
 // The floor under the live tail (the player under load): −80 dB, the dropped modes a part in 1e4 of
 // the string's output under its own partials, where the alternative is dropping a whole key.
 constexpr double kLiveModalFloor = 1e-8;
@@ -164,7 +166,11 @@ class StringVoice {
   // pull on the last two nodes — and pushes the pickups, returning true when `out` holds the next
   // output sample (gain applied); pullOnBridge() is the string's force on the bridge at q^n.
   void wake() noexcept;
-  bool stepOnBridge(double w, double out[2]) noexcept;
+  bool stepOnBridge(double w, double out[2]) noexcept {
+    if (!steadyInModes()) return stepOnBridgeAndScheme(w, out);
+    stepModesOnBridge(w, out);
+    return true;
+  }
   double pullOnBridge(double w) const noexcept {
     using enum ModalTail::Probe;
     return inModes_ ? coupling_.forceFromPull(modal_.at(kPull), w, modal_.residual())
@@ -175,8 +181,7 @@ class StringVoice {
   double endTension() const noexcept {
     const NonlinearString& s = scheme_->system().string();
     if (!steppedLinear_) return s.endTension();
-    return inModes_ ? s.linearEndTension(modal_.lastLongitudinal())
-                    : s.linearEndTension(scheme_->q());
+    return inModes_ ? modal_.endTension() : s.linearEndTension(scheme_->q());
   }
   // The coupling's E_c^{n+½} (BridgeCoupling::energy) with the bridge at w^n, w^{n+1}.
   double couplingEnergy(double w, double wNext) const noexcept;
@@ -219,6 +224,38 @@ class StringVoice {
   void catchHammer() noexcept;
   void applyBend() noexcept;
   bool stepAndPick(double out[2]) noexcept;  // one scheme step; true when a sample is out
+  bool stepOnBridgeAndScheme(double w, double out[2]) noexcept;
+  // In its modes with nothing to do first — no residual to count, no change of the modes due, the
+  // hammer parked clear of the string, the pickups undecimated — a step on the bridge is the
+  // modes' step and their pickups: stepModesOnBridge(), the operations of stepOnBridgeAndScheme()
+  // and stepAndPick() that such a step takes, in their order, inline (the commonest step of a
+  // pedalled texture). The scheme's point forces are left: only its own steps read them, and
+  // stepOnBridgeAndScheme() sets them before each.
+  bool steadyInModes() const noexcept {
+    return inModes_ && residualLeft_ == 0.0 && modesDue_ == ModesDue::none &&
+           decimators_[0].factor() == 1 &&
+           !(scheme_->q()[scheme_->system().hammerIndex()] - modal_.atNext(ModalTail::kContact) >
+             0.0);
+  }
+  void stepModesOnBridge(double w, double out[2]) noexcept {
+    bridgeBefore_ = bridgeAt_;
+    bridgeAt_ = w;
+    steppedLinear_ = linear_;
+    modal_.step(w);
+    ++stepsInModes_;
+    for (int c = 0; c < patch_.channels; ++c)
+      out[c] = modalPickup(c) + 0.0;  // Decimator::push at one tap
+    if (linearisable_ && (scheme_->stepIndex() + stepsInModes_) % kLinearCheckSteps == 0)
+      checkLinear();
+    out[0] *= patch_.gain;
+    out[1] *= patch_.gain;
+  }
+  // Pickup c's signal read from the modes' probes.
+  double modalPickup(int c) const noexcept {
+    const auto p = static_cast<ModalTail::Probe>(ModalTail::kPickup0 + c);
+    return patch_.signal == PickupSignal::displacement ? modal_.at(p)
+                                                       : (modal_.atNext(p) - modal_.at(p)) * rate_;
+  }
   void changeModes() noexcept;  // the modes kept: dropped or restored, as modesDue_ says
   void checkLinear() noexcept;  // every kLinearCheckSteps steps
   void setLinear(bool on) noexcept;
