@@ -134,22 +134,23 @@ void ModalTail::enter(const Vector& q, const Vector& qNext) noexcept {
 
 // The probes at both levels from the kept modes alone.
 void ModalTail::probeAll() noexcept {
-  for (int p = 0; p < kProbes; ++p) {
-    double n = 0.0, next = 0.0;
-    for (int m = 0; m < u_.kept; ++m) {
-      n += weights_[p][m] * u_.now()[m];
-      next += weights_[p][m] * u_.next()[m];
+  // The eight sums of u side by side (each in the order of m), not one after another: eight
+  // chains of additions at once.
+  std::array<double, kProbes> now{}, next{};
+  const double* a = u_.now();
+  const double* aNext = u_.next();
+  for (int m = 0; m < u_.kept; ++m)
+    for (int p = 0; p < kProbes; ++p) {
+      now[p] += weights_[p][m] * a[m];
+      next[p] += weights_[p][m] * aNext[m];
     }
-    now_[p] = n;
-    next_[p] = next;
-  }
-  double n = 0.0, next = 0.0;
+  now_ = now;
+  next_ = next;
+  vLast_ = vLastNext_ = 0.0;
   for (int m = 0; m < v_.kept; ++m) {
-    n += vEnd_[m] * v_.now()[m];
-    next += vEnd_[m] * v_.next()[m];
+    vLast_ += vEnd_[m] * v_.now()[m];
+    vLastNext_ += vEnd_[m] * v_.next()[m];
   }
-  vLast_ = n;
-  vLastNext_ = next;
 }
 
 void ModalTail::leave(Vector& q, Vector& qNext) const noexcept {
