@@ -659,7 +659,7 @@ void StringVoice::enterModes() noexcept {
 
 // The modes dropped come back at rest, and with them the coupling's full self-stiffness: the
 // coupling energy gains ½ residual w^n w^{n+1}, counted as injected at the next step's start, where
-// the bridge's w^{n+1} is known (stepOnBridge), or at once where the step is starting.
+// the bridge's w^{n+1} is known (stepOnBridgeAndScheme), or at once where the step is starting.
 void StringVoice::leaveModes() noexcept {
   const double before = energy();
   levelN_ = scheme_->q();  // the same size: no allocation
@@ -688,10 +688,7 @@ bool StringVoice::stepAndPick(double out[2]) noexcept {
   steppedLinear_ = linear_;
   if (inModes_) {
     if (modesDue_ != ModesDue::none) changeModes();
-    // The hammer parked below: should the string swing down onto it, the step is the scheme's,
-    // with the felt's force, and the back-check meets the hammer as on the nodes.
-    const double hammer = scheme_->q()[scheme_->system().hammerIndex()];
-    if (hammer - modal_.atNext(ModalTail::kContact) > 0.0) {
+    if (hammerMeetsModes()) {
       leaveModes();
       injected_ += 0.5 * residualLeft_ * bridgeBefore_ * bridgeAt_;
       residualLeft_ = 0.0;

@@ -233,9 +233,12 @@ class StringVoice {
   // stepOnBridgeAndScheme() sets them before each.
   bool steadyInModes() const noexcept {
     return inModes_ && residualLeft_ == 0.0 && modesDue_ == ModesDue::none &&
-           decimators_[0].factor() == 1 &&
-           !(scheme_->q()[scheme_->system().hammerIndex()] - modal_.atNext(ModalTail::kContact) >
-             0.0);
+           decimators_[0].factor() == 1 && !hammerMeetsModes();
+  }
+  // The hammer parked below a string in its modes: should the string swing down onto it, the step
+  // is the scheme's, with the felt's force, and the back-check meets the hammer as on the nodes.
+  bool hammerMeetsModes() const noexcept {
+    return scheme_->q()[scheme_->system().hammerIndex()] - modal_.atNext(ModalTail::kContact) > 0.0;
   }
   void stepModesOnBridge(double w, double out[2]) noexcept {
     bridgeBefore_ = bridgeAt_;

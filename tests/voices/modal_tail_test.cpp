@@ -266,6 +266,32 @@ TEST(ModalTail, OnTheBridgeTheDroppedModesKeepTheirStaticGive) {
   EXPECT_LE(worst, 1e-3 * peakAfter);
 }
 
+// The pickups' gain is an output scale alone: a key whose strings have twice the gain gives twice
+// the samples, exactly (a product by 2 is exact), on both channels, on its nodes and in its modes —
+// the step of a string in its modes reads its pickups apart from the scheme's (stepOnBridge).
+TEST(ModalTail, ThePickupsGainScalesBothChannelsInTheModes) {
+  const Instrument piano = loadPreset(HAMILTONE_SOURCE_DIR "/presets/grand-piano.toml");
+  Instrument louder = piano;
+  for (StringKey& key : louder.keys) key.patch.gain *= 2.0;
+  UnisonStrings once, twice;
+  once.prepare(piano, 60, kRate, 256);
+  twice.prepare(louder, 60, kRate, 256);
+  ASSERT_EQ(once.channels(), 2);
+  once.noteOn(0.5, false);
+  twice.noteOn(0.5, false);
+  std::vector<float> l(256), r(256), l2(256), r2(256);
+  int mismatched = 0, blocksInModes = 0;
+  for (int n = 0; n < 3 * 188; ++n) {
+    once.process(l, r);
+    twice.process(l2, r2);
+    for (size_t i = 0; i < l.size(); ++i)
+      mismatched += (l2[i] != 2.0f * l[i]) + (r2[i] != 2.0f * r[i]);
+    blocksInModes += once.stringsInModes() == 3;
+  }
+  EXPECT_EQ(mismatched, 0);
+  EXPECT_GT(blocksInModes, 188);  // a second of it with every string in its modes
+}
+
 // A lossless C3 on a lossless, upright bridge (every loss and the bridge's angle set off over the
 // grand piano): what it holds — strings, couplings, bridge — plus what its strings' back-checks and
 // dropped modes removed, less what strikes and switches injected, stays constant to roundoff
