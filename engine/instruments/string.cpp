@@ -163,7 +163,8 @@ double NonlinearString::blockStableStep(double sigma1, double vTension) const {
 
 double NonlinearString::linearEndTension(const Vector& q) const {
   const int mv = grid_.longitudinal;
-  return mv < 2 ? 0.0 : linearEndTension(q[segments_ - 1 + mv - 2]);  // η_M = −v_{Mv−1}/h_v
+  // η_M = −v_{Mv−1}/h_v; EA / h_v depends on constants alone, so the product does not wait on it.
+  return mv < 2 ? 0.0 : -q[segments_ - 1 + mv - 2] * (physics_.young * physics_.area / hv_);
 }
 
 void NonlinearString::applyLossOperator(const Vector& a, const Vector& b, Vector& out) const {

@@ -124,12 +124,6 @@ class NonlinearString {
   double linearisedMaxStableStep(double sigma1) const;
   // ΔT at the far end of the linear string at q: EA η_M (0 with one coarse cell, Mv = 1).
   double linearEndTension(const Vector& q) const;
-  // The same from v_{Mv−1}, the last node of v.
-  double linearEndTension(double lastV) const {
-    // The bridge's chain of latencies runs through v each step: v's part is a product; EA / h_v
-    // depends on constants alone, so it does not wait on v.
-    return grid_.longitudinal < 2 ? 0.0 : -lastV * (physics_.young * physics_.area / hv_);
-  }
 
   // Eigenvalue m = 1 … M−1 of M⁻¹K on u: (βT0/ρA)(4/h²) s² + (EI/ρA)(16/h⁴) s⁴, s = sin(mπ/2M).
   double transverseEigenvalue(int m) const;

@@ -281,15 +281,24 @@ TEST(ModalTail, ThePickupsGainScalesBothChannelsInTheModes) {
   twice.noteOn(0.5, false);
   std::vector<float> l(256), r(256), l2(256), r2(256);
   int mismatched = 0, blocksInModes = 0;
+  float peakInModes[2] = {0.0f, 0.0f};  // both channels sound there: 0 = 2·0 would prove nothing
   for (int n = 0; n < 3 * 188; ++n) {
     once.process(l, r);
     twice.process(l2, r2);
-    for (size_t i = 0; i < l.size(); ++i)
+    const bool inModes = once.stringsInModes() == 3;
+    for (size_t i = 0; i < l.size(); ++i) {
       mismatched += (l2[i] != 2.0f * l[i]) + (r2[i] != 2.0f * r[i]);
-    blocksInModes += once.stringsInModes() == 3;
+      if (inModes) {
+        peakInModes[0] = std::max(peakInModes[0], std::abs(l[i]));
+        peakInModes[1] = std::max(peakInModes[1], std::abs(r[i]));
+      }
+    }
+    blocksInModes += inModes;
   }
   EXPECT_EQ(mismatched, 0);
   EXPECT_GT(blocksInModes, 188);  // a second of it with every string in its modes
+  EXPECT_GT(peakInModes[0], 1e-4f);
+  EXPECT_GT(peakInModes[1], 1e-4f);
 }
 
 // A lossless C3 on a lossless, upright bridge (every loss and the bridge's angle set off over the
